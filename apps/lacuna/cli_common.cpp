@@ -1,0 +1,108 @@
+#include "cli_common.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "lacuna/error.h"
+
+namespace lacuna::cli {
+
+void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required) {
+    auto* opt = cmd.add_option("volume", a.path,
+                               "Volume file (.nii .nii.gz .nrrd .nhdr .mha .mhd .raw) or DICOM folder");
+    if (required) opt->required();
+    cmd.add_option("--dims", a.raw_dims, "Raw files: dimensions, e.g. 301x370x316");
+    cmd.add_option("--type", a.raw_type, "Raw files: voxel type (uint8, int16, uint16, float32)");
+    cmd.add_option("--range", a.range,
+                   "Visualization range MIN:MAX mapped onto the TF domain (default: data range)");
+}
+
+Vec3i parse_dims(const std::string& s, const std::string& where) {
+    Vec3i d{0, 0, 0};
+    int n = 0;
+    size_t pos = 0;
+    for (int a = 0; a < 3; ++a) {
+        size_t end = s.find_first_of("xX", pos);
+        std::string part = s.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+        if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos ||
+            part.size() > 9)
+            break;
+        d[a] = std::stoi(part);
+        ++n;
+        if (end == std::string::npos) break;
+        pos = end + 1;
+        if (a == 2) n = -1;  // trailing text after the third number
+    }
+    if (n != 3) throw Error(where, "dims", "expected AxBxC (e.g. 301x370x316), got '" + s + "'");
+    return d;
+}
+
+Volume load_volume(const VolumeArgs& a) {
+    ReadOptions ro;
+    if (!a.raw_dims.empty() || !a.raw_type.empty()) {
+        RawSpec spec;
+        if (a.raw_dims.empty() || a.raw_type.empty())
+            throw Error("--dims/--type", "raw layout", "give both --dims and --type for a raw file");
+        spec.dims = parse_dims(a.raw_dims, "--dims");
+        spec.type = parse_voxel_type(a.raw_type, "--type");
+        ro.raw = spec;
+    }
+    Progress progress("loading " + std::filesystem::path(a.path).filename().string());
+    ro.progress = [&](double f) { progress.update(f); };
+    Volume v = read_volume(a.path, ro);
+    progress.done();
+    if (!a.range.empty()) {
+        size_t c = a.range.find(':');
+        if (c == std::string::npos) throw Error("--range", "range", "expected MIN:MAX, got '" + a.range + "'");
+        try {
+            size_t used = 0;
+            float lo = std::stof(a.range.substr(0, c), &used);
+            if (used != c) throw std::invalid_argument("x");
+            std::string rest = a.range.substr(c + 1);
+            float hi = std::stof(rest, &used);
+            if (used != rest.size()) throw std::invalid_argument("x");
+            v.set_vis_range({lo, hi});
+        } catch (const std::logic_error&) {
+            throw Error("--range", "range", "expected MIN:MAX numbers, got '" + a.range + "'");
+        }
+    }
+    return v;
+}
+
+void check_output_path(const std::string& path, const std::string& ext) {
+    namespace fs = std::filesystem;
+    fs::path p(path);
+    if (p.extension() != ext) throw Error(path, "output", "expected a " + ext + " file name");
+    fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw Error(path, "output", "folder '" + dir.string() + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw Error(path, "output", "folder '" + dir.string() + "' is not writable");
+    if (fs::is_directory(p, ec)) throw Error(path, "output", "is a folder");
+}
+
+Progress::Progress(std::string what)
+    : m_what(std::move(what)), m_tty(::isatty(2)), m_start(std::chrono::steady_clock::now()) {
+    if (m_tty) std::fprintf(stderr, "%s ...", m_what.c_str());
+}
+
+void Progress::update(double f) {
+    if (m_tty && !m_done) std::fprintf(stderr, "\r%s ... %3d%%", m_what.c_str(), int(f * 100 + 0.5));
+}
+
+void Progress::done() {
+    if (m_done) return;
+    m_done = true;
+    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+    if (m_tty) std::fprintf(stderr, "\r%s ... done in %.2f s\n", m_what.c_str(), s);
+}
+
+Progress::~Progress() {
+    // Abandoned on an exception: end the line so the error message starts cleanly.
+    if (m_tty && !m_done) std::fprintf(stderr, "\n");
+}
+
+}  // namespace lacuna::cli

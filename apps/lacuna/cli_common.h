@@ -1,0 +1,51 @@
+// Shared pieces of the lacuna CLI: the only place strings become typed options (STYLE.md 3).
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <string>
+
+#include "lacuna/camera.h"
+#include "lacuna/io.h"
+#include "lacuna/volume.h"
+
+namespace lacuna::cli {
+
+// Options shared by every command that loads a volume.
+struct VolumeArgs {
+    std::string path;
+    std::string raw_dims;  // "301x370x316"
+    std::string raw_type;  // "uint8"
+    std::string range;     // "MIN:MAX" visualization range override
+};
+void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required = true);
+// Loads the volume (with a progress line on a terminal) and applies --range.
+Volume load_volume(const VolumeArgs& a);
+
+// Parses "AxBxC" into dims; throws lacuna::Error(where, "dims", ...).
+Vec3i parse_dims(const std::string& s, const std::string& where);
+
+// Fails early (before any work) if `path` cannot be created: its folder must exist and be
+// writable, and it must end with `ext`. Throws lacuna::Error(path, "output", ...).
+void check_output_path(const std::string& path, const std::string& ext);
+
+// A progress line on stderr, shown only when stderr is a terminal.
+class Progress {
+public:
+    explicit Progress(std::string what);
+    void update(double fraction);
+    void done();
+    ~Progress();
+
+private:
+    std::string m_what;
+    bool m_tty;
+    bool m_done = false;
+    std::chrono::steady_clock::time_point m_start;
+};
+
+void register_info(CLI::App& app);
+void register_render(CLI::App& app);
+void register_generate(CLI::App& app);
+
+}  // namespace lacuna::cli

@@ -1,0 +1,63 @@
+// `lacuna info`: what a volume file holds — dims, type, spacing, orientation, value range and a
+// histogram summary.
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "cli_common.h"
+
+namespace lacuna::cli {
+
+namespace {
+
+void run(const VolumeArgs& args) {
+    const Volume v = load_volume(args);
+    const Vec3i d = v.dims();
+    std::printf("file:        %s\n", args.path.c_str());
+    std::printf("dims:        %d x %d x %d (%zu voxels, %.1f MiB)\n", d.x, d.y, d.z, v.voxel_count(),
+                double(v.bytes()) / (1 << 20));
+    std::printf("type:        %s\n", to_string(v.type()).c_str());
+    std::printf("spacing:     %g x %g x %g mm\n", v.spacing.x, v.spacing.y, v.spacing.z);
+    std::printf("origin:      %g, %g, %g\n", v.origin.x, v.origin.y, v.origin.z);
+    std::printf("orientation: [%g %g %g] [%g %g %g] [%g %g %g]\n", v.direction[0], v.direction[1],
+                v.direction[2], v.direction[3], v.direction[4], v.direction[5], v.direction[6],
+                v.direction[7], v.direction[8]);
+    const ValueRange r = v.data_range(), vr = v.vis_range();
+    std::printf("value range: %g .. %g\n", r.min, r.max);
+    std::printf("vis range:   %g .. %g\n", vr.min, vr.max);
+
+    // 16-bin histogram over the data range, plus the share of voxels at the minimum (background).
+    constexpr int kBins = 16;
+    std::vector<uint64_t> hist(kBins, 0);
+    uint64_t at_min = 0;
+    const float scale = r.max > r.min ? float(kBins) / (r.max - r.min) : 0.f;
+    visit_voxels(v, [&](const auto* p) {
+        const size_t n = v.voxel_count();
+        for (size_t i = 0; i < n; ++i) {
+            const float x = float(p[i]);
+            at_min += x == r.min;
+            hist[std::min(kBins - 1, int((x - r.min) * scale))]++;
+        }
+    });
+    const double n = double(v.voxel_count());
+    std::printf("at minimum:  %.1f%% of voxels\n", 100.0 * double(at_min) / n);
+    std::printf("histogram:   (%d bins over the value range, %% of voxels)\n", kBins);
+    const uint64_t peak = *std::max_element(hist.begin(), hist.end());
+    for (int b = 0; b < kBins; ++b) {
+        const float lo = r.min + (r.max - r.min) * float(b) / kBins;
+        const int bar = peak ? int(40.0 * double(hist[b]) / double(peak) + 0.5) : 0;
+        std::printf("  %10.4g  %5.1f%%  %s\n", lo, 100.0 * double(hist[b]) / n,
+                    std::string(size_t(bar), '#').c_str());
+    }
+}
+
+}  // namespace
+
+void register_info(CLI::App& app) {
+    auto a = std::make_shared<VolumeArgs>();
+    auto* cmd = app.add_subcommand("info", "Describe a volume file");
+    add_volume_args(*cmd, *a);
+    cmd->callback([a] { run(*a); });
+}
+
+}  // namespace lacuna::cli

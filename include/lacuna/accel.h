@@ -1,0 +1,73 @@
+// Empty-space skipping structures, selected by `--accel NAME`.
+//
+// Every structure answers one question (STYLE.md habit 1): for the cell a ray is in, what is the
+// largest axis-aligned box of cells around it that is provably invisible under the current
+// transfer function ("empty"), or else which box of cells it may stop looking at ("occupied")?
+// One generic cursor (src/accel/cursor.h) turns those answers into the stretches of a ray that
+// may contain visible samples; the ray marcher samples only there, on the reference lattice.
+//
+// Adding a structure = one file in src/accel/, one AccelKind value, one factory case in
+// src/accel/accel.cpp; it is then in the conformance tests and the benchmarks automatically.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lacuna/transfer_function.h"
+#include "lacuna/volume.h"
+
+namespace lacuna {
+
+enum class AccelKind {
+    None,       // march every lattice sample of the ray's box interval (the reference)
+    MinMax,     // min-max octree; empty when the TF's opacity prefix sum is 0 over [min, max]
+    Bitfield,   // the bitfield paper's TF-independent octree (bins of the visualization range)
+    Boolean,    // TF-dependent occupancy octree, rebuilt when the TF changes
+    Distance,   // Euclidean distance map at 1/4 resolution, rebuilt when the TF changes
+    Chebyshev,  // Chebyshev distance map at 1/4 resolution, rebuilt when the TF changes
+};
+
+std::string to_string(AccelKind k);
+// Throws lacuna::Error("--accel", "structure", "unknown 'x'; expected one of: ...").
+AccelKind parse_accel(const std::string& name);
+std::vector<std::string> accel_names();
+// Every kind, None first: what the conformance tests and benchmarks iterate over.
+std::vector<AccelKind> all_accel_kinds();
+
+struct AccelOptions {
+    int leaf_cells = 8;        // octree leaf edge in cells (2..64, power of two)
+    int bitfield_bits = 64;    // bitfield width: 8, 16, 32, 64 or 128
+    int initial_level = -1;    // octree level traversal starts at (-1 = the root)
+    bool bidirectional = true; // octree traversal moves up and down (false: top-down only)
+    int distance_block = 4;    // distance maps: cells per map voxel (the paper's 1/4 resolution)
+    int threads = 0;           // build threads (0 = all)
+};
+
+struct AccelStats {
+    double build_seconds = 0;      // TF-independent build (on load)
+    double tf_update_seconds = 0;  // last TF change to ready-to-render
+    size_t bytes = 0;              // memory of the structure
+    size_t nodes = 0;              // nodes (octrees) or map voxels (distance maps)
+};
+
+// A built structure over one volume. Concrete types live in src/accel/; renderers reach them
+// through visit() in src/accel/accel_impl.h, once per frame, never per sample.
+class Accel {
+public:
+    virtual ~Accel() = default;
+    AccelKind kind() const { return m_kind; }
+    // Must be called before rendering and whenever the TF changes.
+    virtual void set_transfer_function(const TransferLut& lut) = 0;
+    const AccelStats& stats() const { return m_stats; }
+
+protected:
+    explicit Accel(AccelKind k) : m_kind(k) {}
+    AccelKind m_kind;
+    AccelStats m_stats;
+};
+
+// Builds the structure of kind `k` over `volume` (which must outlive it). For None returns a
+// trivial structure. Throws lacuna::Error for invalid options.
+std::unique_ptr<Accel> make_accel(AccelKind k, const Volume& volume, const AccelOptions& opts = {});
+
+}  // namespace lacuna

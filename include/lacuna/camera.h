@@ -1,0 +1,53 @@
+// Camera: perspective or orthographic, placed by orbit parameters around a target.
+// World space is the volume's: x right, y up (index j), z toward the viewer at azimuth 0.
+#pragma once
+#include <string>
+
+#include "lacuna/math.h"
+
+namespace lacuna {
+
+enum class Projection { Perspective, Orthographic };
+
+struct Ray {
+    Vec3f origin;
+    Vec3f dir;  // unit length
+};
+
+// Orbit placement. Azimuth rotates about the world y axis, elevation lifts toward +y.
+// distance <= 0 means "frame the whole bounds" (the default); zoom > 1 moves closer.
+struct OrbitParams {
+    float azimuth_deg = 30.f;
+    float elevation_deg = 20.f;
+    float zoom = 1.f;
+    float distance = 0.f;
+    bool has_target = false;
+    Vec3f target{};  // used when has_target; otherwise the centre of the bounds
+    float fov_y_deg = 30.f;
+    Projection projection = Projection::Perspective;
+};
+
+class Camera {
+public:
+    Camera() = default;
+    // A camera that sees all of `bounds` (world box) for the given image size.
+    static Camera orbit(const Box3f& bounds, const OrbitParams& p, int width, int height);
+
+    // The ray through the centre of pixel (px, py); py = 0 is the top row.
+    Ray generate(float px, float py) const;
+    int width() const { return m_width; }
+    int height() const { return m_height; }
+    Vec3f eye() const { return m_eye; }
+    Vec3f forward() const { return m_forward; }
+    Projection projection() const { return m_projection; }
+
+private:
+    Vec3f m_eye{}, m_forward{0, 0, -1}, m_right{1, 0, 0}, m_up{0, 1, 0};
+    float m_half_h = 1.f;  // tan(fov/2) for perspective; half the view height for orthographic
+    int m_width = 1, m_height = 1;
+    Projection m_projection = Projection::Perspective;
+    friend std::string to_string(const Camera&);
+};
+std::string to_string(const Camera& c);
+
+}  // namespace lacuna

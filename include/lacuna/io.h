@@ -1,0 +1,40 @@
+// Volume readers and writers: one interface, implemented in src/io/ (ITK's image IO for
+// NIfTI-1/2, NRRD, MetaImage and DICOM series; our own code for raw files).
+#pragma once
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "lacuna/volume.h"
+
+namespace lacuna {
+
+struct RawSpec {
+    Vec3i dims{0, 0, 0};
+    VoxelType type = VoxelType::UInt8;
+    Vec3d spacing{1, 1, 1};
+    bool big_endian = false;
+};
+
+struct ReadOptions {
+    // For .raw files: explicit layout; when unset, parsed from "name_301x370x316_uint8.raw".
+    std::optional<RawSpec> raw;
+    // Called with a fraction in [0,1] during long reads (may be null).
+    std::function<void(double)> progress;
+};
+
+// Reads a volume: .nii/.nii.gz (NIfTI-1/2), .nrrd/.nhdr, .mha/.mhd, a folder of DICOM slices,
+// or .raw. Voxel types other than uint8/int16/uint16/float32 are converted (int8 -> int16,
+// uint32/int32/float64 -> float32); non-scalar images are rejected. Computes the value range
+// and rejects NaN/Inf. The voxels are read once into the Volume's own buffer (no second
+// full-size copy). Throws lacuna::Error("<path>", "<field>", "<problem>") on any bad input.
+Volume read_volume(const std::string& path, const ReadOptions& opts = {});
+
+// Parses "name_301x370x316_uint8.raw"-style names; nullopt if the name does not match.
+std::optional<RawSpec> raw_spec_from_name(const std::string& path);
+
+// Writes a volume as .nrrd, .nhdr, .nii, .nii.gz, .mha or .mhd (by extension), atomically
+// (temporary file + rename). Throws lacuna::Error on failure.
+void write_volume(const std::string& path, const Volume& v);
+
+}  // namespace lacuna

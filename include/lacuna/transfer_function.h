@@ -1,0 +1,109 @@
+// Transfer functions: piecewise-linear colour and opacity over the visualization range,
+// discretised to a lookup table (LUT). JSON format: docs/transfer-functions.md.
+//
+// Value -> LUT entry mapping (one definition, used by the renderers AND the skipping
+// structures, so both agree on which entry a sample reads):
+//     u   = (v - vis.min) * (size-1) / (vis.max - vis.min)
+//     idx = clamp(int(u + 0.5), 0, size-1)
+// The map is monotone in v, so every sample whose value lies in [lo, hi] reads an entry in
+// [idx(lo), idx(hi)]: that is what makes per-cell value ranges sufficient for exact skipping.
+#pragma once
+#include <array>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lacuna/volume.h"
+
+namespace lacuna {
+
+inline constexpr int kDefaultLutSize = 1024;
+
+// Where control point positions x live.
+enum class TfDomain {
+    Normalized,  // x in [0,1] across the volume's visualization range (portable presets)
+    Value,       // x in voxel values (like VTK / 3D Slicer)
+};
+std::string to_string(TfDomain d);  // "normalized" / "value", as in the JSON format
+
+// Two points with equal x form a step: the TF takes the first one's value just left of x and
+// the second one's value at x and to its right (at most two points may share an x).
+struct ColorPoint {
+    double x = 0;
+    float r = 0, g = 0, b = 0;  // linear RGB in [0,1]
+    friend bool operator==(const ColorPoint&, const ColorPoint&) = default;
+};
+struct OpacityPoint {
+    double x = 0;
+    float a = 0;  // opacity per unit sample distance (one voxel of the smallest spacing), [0,1]
+    friend bool operator==(const OpacityPoint&, const OpacityPoint&) = default;
+};
+
+struct TransferFunction {
+    std::string name;
+    TfDomain domain = TfDomain::Normalized;
+    std::vector<ColorPoint> color;      // sorted by x, at least one point
+    std::vector<OpacityPoint> opacity;  // sorted by x, at least one point
+    // Optional visualization range carried by the TF file (values); overrides the volume's.
+    std::optional<ValueRange> range;
+};
+std::string to_string(const TransferFunction& tf);
+// Exact equality of every field (the JSON round trip is exact).
+bool operator==(const TransferFunction& a, const TransferFunction& b);
+// GoogleTest prints a TransferFunction through this (found by ADL).
+void PrintTo(const TransferFunction& tf, std::ostream* os);
+
+// Linear interpolation of two TFs with the same domain (bitfield paper, Section 4.5: the TF
+// animation). Control points are merged at the union of both x sets. w in [0,1].
+TransferFunction lerp(const TransferFunction& a, const TransferFunction& b, float w);
+
+// RGBA per LUT entry; colour straight (not premultiplied), alpha per unit distance.
+struct Rgba {
+    float r = 0, g = 0, b = 0, a = 0;
+    friend bool operator==(const Rgba&, const Rgba&) = default;
+};
+std::string to_string(const Rgba& c);
+
+class ValueToLut {
+public:
+    ValueToLut() = default;
+    ValueToLut(ValueRange vis, int size)
+        : m_min(vis.min), m_scale(float(size - 1) / (vis.max - vis.min)), m_last(size - 1) {}
+    int operator()(float v) const {
+        float u = (v - m_min) * m_scale + 0.5f;
+        u = u < 0.f ? 0.f : (u > float(m_last) ? float(m_last) : u);
+        return int(u);
+    }
+    int size() const { return m_last + 1; }
+
+private:
+    float m_min = 0, m_scale = 1;
+    int m_last = 0;
+};
+
+struct TransferLut {
+    std::vector<Rgba> entries;
+    ValueRange vis;  // the range this LUT was discretised over
+    ValueToLut map() const { return ValueToLut(vis, int(entries.size())); }
+    int size() const { return int(entries.size()); }
+};
+
+// Discretises tf over `vis` (tf.range, when set, wins) into `size` entries: entry e holds the
+// piecewise-linear TF evaluated at the value vis.min + e*(vis.max-vis.min)/(size-1).
+TransferLut discretise(const TransferFunction& tf, ValueRange vis, int size = kDefaultLutSize);
+
+// Built-in presets (normalized domain): ct-bone, ct-skin, ct-soft-tissue, mr-default, mr-skin,
+// mr-brain, mr-gap. Throws lacuna::Error listing the valid names for an unknown one.
+TransferFunction preset(const std::string& name);
+std::vector<std::string> preset_names();
+
+// JSON (docs/transfer-functions.md). `where` is the file name used in error messages.
+TransferFunction parse_transfer_function(const std::string& json_text, const std::string& where);
+TransferFunction load_transfer_function(const std::string& path);
+std::string to_json(const TransferFunction& tf);
+
+// "--tf" argument: a preset name, or a path to a .json file.
+TransferFunction resolve_transfer_function(const std::string& spec);
+
+}  // namespace lacuna

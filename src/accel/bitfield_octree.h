@@ -1,0 +1,45 @@
+// --accel bitfield: the bitfield paper's TF-independent octree (Sections 3.1-3.4).
+//
+// The visualization range's LUT entries are split into `bits` equal bins (8..128); bin of entry
+// e = e * bits / lut_size. A leaf's bitfield has bit b set when one of its cells can produce a
+// sample in bin b: a cell whose corner range maps to entries [lo, hi] sets every bin from bin(lo)
+// to bin(hi) (a cell with corners in bins 2 and 9 also covers 3..8). Inner nodes are the OR of
+// their children. The TF is encoded as a bitfield of the same width: bit b set when any LUT entry
+// of bin b has non-zero opacity. A node is empty when (node AND tf) == 0. A TF change only
+// recomputes the TF bitfield (O(lut size)); the tree is built once per volume.
+//
+// Node layout: `words` uint64 per node (1 for <= 64 bits, 2 for 128), bit b in word b/64.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "accel/octree_base.h"
+
+namespace lacuna {
+
+class BitfieldOctree final : public OctreeBase {
+public:
+    BitfieldOctree(const Volume& v, const AccelOptions& o);
+    void set_transfer_function(const TransferLut& lut) override;
+    Region region(const int cell[3], int& hint) const {
+        return octree_region(m_pyr, cell, hint, m_start, m_opts.bidirectional, [&](size_t i) {
+            const uint64_t* w = &m_bits[i * size_t(m_words)];
+            uint64_t hit = w[0] & m_tf[0];
+            if (m_words == 2) hit |= w[1] & m_tf[1];
+            return hit == 0;
+        });
+    }
+    using Cursor = RegionCursor<BitfieldOctree>;
+    int bits() const { return m_nbits; }
+    // The TF bitfield (tests, the viewer's overlay).
+    const uint64_t* tf_bits() const { return m_tf; }
+
+private:
+    void build();
+    int bin(int entry) const { return int(int64_t(entry) * m_nbits / m_lut_size); }
+    int m_nbits = 64, m_words = 1;
+    std::vector<uint64_t> m_bits;
+    uint64_t m_tf[2] = {0, 0};
+};
+
+}  // namespace lacuna

@@ -1,0 +1,120 @@
+#include "accel/cell_ranges.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+#include "core/parallel.h"
+
+namespace lacuna {
+
+namespace {
+
+// LUT-entry bounds of one voxel value, widened by a relative 1e-6 on both sides: float
+// trilinear arithmetic (even on integer corners, once fractions enter) can land an ulp outside
+// the corner range, and the widening keeps the bounds conservative. Integer voxels: two tables
+// over every possible value.
+template <class T>
+struct VoxelLut {
+    static constexpr bool kTable = sizeof(T) <= 2 && std::is_integral_v<T>;
+    std::vector<uint16_t> lo_table, hi_table;
+    ValueToLut map;
+    float widen = 0;
+    explicit VoxelLut(ValueToLut m, ValueRange vis)
+        : map(m), widen(1e-6f * (std::abs(vis.min) + std::abs(vis.max))) {
+        if constexpr (kTable) {
+            const int lo = std::numeric_limits<T>::min(), hi = std::numeric_limits<T>::max();
+            lo_table.resize(size_t(hi - lo + 1));
+            hi_table.resize(size_t(hi - lo + 1));
+            for (int x = lo; x <= hi; ++x) {
+                uint16_t a, b;
+                compute(float(x), a, b);
+                lo_table[size_t(x - lo)] = a;
+                hi_table[size_t(x - lo)] = b;
+            }
+        }
+    }
+    void compute(float x, uint16_t& lo, uint16_t& hi) const {
+        const float w = widen + 1e-6f * std::abs(x);
+        lo = uint16_t(map(x - w));
+        hi = uint16_t(map(x + w));
+    }
+    void bounds(T x, uint16_t& lo, uint16_t& hi) const {
+        if constexpr (kTable) {
+            const size_t e = size_t(int(x) - int(std::numeric_limits<T>::min()));
+            lo = lo_table[e];
+            hi = hi_table[e];
+        } else {
+            compute(float(x), lo, hi);
+        }
+    }
+};
+
+template <class T>
+void blocks_typed(const Volume& v, const T* data, ValueToLut map, int edge, int threads,
+                  const std::function<void(const BlockCells&)>& fn) {
+    int cells[3];
+    cell_counts(v, cells);
+    int nb[3];
+    for (int a = 0; a < 3; ++a) nb[a] = (cells[a] + edge - 1) / edge;
+    const VoxelLut<T> vl(map, v.vis_range());
+    const Vec3i d = v.dims();
+    const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
+    parallel_for(size_t(nb[2]) * size_t(nb[1]), threads, [&](size_t b0, size_t b1) {
+        const size_t m = size_t(edge + 1);
+        std::vector<uint16_t> vlo(m * m * m), vhi(m * m * m), clo(m * m * m), chi(m * m * m);
+        for (size_t b = b0; b < b1; ++b) {
+            const int bz = int(b / size_t(nb[1])), by = int(b % size_t(nb[1]));
+            for (int bx = 0; bx < nb[0]; ++bx) {
+                BlockCells bc;
+                bc.block[0] = bx, bc.block[1] = by, bc.block[2] = bz;
+                bc.c0[0] = bx * edge, bc.c0[1] = by * edge, bc.c0[2] = bz * edge;
+                for (int a = 0; a < 3; ++a) bc.n[a] = std::min(edge, cells[a] - bc.c0[a]);
+                const int vx = bc.n[0] + 1, vy = bc.n[1] + 1, vz = bc.n[2] + 1;
+                // 1. Voxel LUT bounds of the block's (n+1)^3 voxels.
+                for (int k = 0; k < vz; ++k)
+                    for (int j = 0; j < vy; ++j) {
+                        const T* row = data + size_t(bc.c0[2] + k) * sz +
+                                       size_t(bc.c0[1] + j) * sy + size_t(bc.c0[0]);
+                        uint16_t* lo = &vlo[(size_t(k) * vy + j) * vx];
+                        uint16_t* hi = &vhi[(size_t(k) * vy + j) * vx];
+                        for (int i = 0; i < vx; ++i) vl.bounds(row[i], lo[i], hi[i]);
+                    }
+                // 2. Separable min/max over pairs: x, then y, then z. Each pass shrinks one
+                // axis by one; the result has n cells per axis.
+                auto pass = [](const uint16_t* in, uint16_t* out, int nx, int ny, int nz, int ax,
+                               bool take_max) {
+                    const int ox = nx - (ax == 0), oy = ny - (ax == 1), oz = nz - (ax == 2);
+                    const size_t step = ax == 0 ? 1 : (ax == 1 ? size_t(nx) : size_t(nx) * ny);
+                    for (int k = 0; k < oz; ++k)
+                        for (int j = 0; j < oy; ++j) {
+                            const uint16_t* a = in + (size_t(k) * ny + j) * nx;
+                            uint16_t* o = out + (size_t(k) * oy + j) * ox;
+                            for (int i = 0; i < ox; ++i)
+                                o[i] = take_max ? std::max(a[i], a[i + step])
+                                                : std::min(a[i], a[i + step]);
+                        }
+                };
+                pass(vlo.data(), clo.data(), vx, vy, vz, 0, false);
+                pass(clo.data(), vlo.data(), vx - 1, vy, vz, 1, false);
+                pass(vlo.data(), clo.data(), vx - 1, vy - 1, vz, 2, false);
+                pass(vhi.data(), chi.data(), vx, vy, vz, 0, true);
+                pass(chi.data(), vhi.data(), vx - 1, vy, vz, 1, true);
+                pass(vhi.data(), chi.data(), vx - 1, vy - 1, vz, 2, true);
+                bc.lo = clo.data();
+                bc.hi = chi.data();
+                fn(bc);
+            }
+        }
+    });
+}
+
+}  // namespace
+
+void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,
+                          const std::function<void(const BlockCells&)>& fn) {
+    visit_voxels(v, [&](const auto* data) { blocks_typed(v, data, map, edge, threads, fn); });
+}
+
+}  // namespace lacuna

@@ -1,0 +1,54 @@
+// Per-cell LUT-entry ranges, computed block by block: the TF-independent raw material of every
+// skipping structure.
+//
+// A trilinear sample in cell (i,j,k) lies between the min and max of the cell's 8 corner voxels
+// (i..i+1, j..j+1, k..k+1), and ValueToLut is monotone, so it reads a LUT entry in
+// [map(min corner), map(max corner)]. Float32 grids are widened by a relative 1e-6 before
+// mapping: float trilinear arithmetic can exceed its corners by an ulp.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "lacuna/transfer_function.h"
+#include "lacuna/volume.h"
+
+namespace lacuna {
+
+// Cell ranges of one block of cells [c0, c0 + n) (n <= edge on each axis; clipped at the grid
+// edge). lo/hi hold n[0]*n[1]*n[2] entries, x fastest.
+struct BlockCells {
+    int block[3];  // block coordinates
+    int c0[3];     // first cell
+    int n[3];      // cells per axis in this block
+    const uint16_t* lo;
+    const uint16_t* hi;
+};
+
+// Calls fn for every block of edge `edge` cells, in parallel over z-slabs of blocks. fn must be
+// thread-safe for distinct blocks.
+void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,
+                          const std::function<void(const BlockCells&)>& fn);
+
+// Cells per axis (dims - 1) and blocks per axis for a block edge.
+inline void cell_counts(const Volume& v, int cells[3]) {
+    const Vec3i d = v.dims();
+    cells[0] = d.x - 1, cells[1] = d.y - 1, cells[2] = d.z - 1;
+}
+
+// Prefix count of LUT entries with non-zero opacity: visible(lo, hi) in O(1) (min-max paper
+// trick).
+class OpacityPrefix {
+public:
+    void build(const TransferLut& lut) {
+        m_prefix.assign(lut.entries.size() + 1, 0);
+        for (size_t e = 0; e < lut.entries.size(); ++e)
+            m_prefix[e + 1] = m_prefix[e] + (lut.entries[e].a > 0.f ? 1u : 0u);
+    }
+    bool visible(int lo, int hi) const { return m_prefix[size_t(hi) + 1] != m_prefix[size_t(lo)]; }
+
+private:
+    std::vector<uint32_t> m_prefix;
+};
+
+}  // namespace lacuna

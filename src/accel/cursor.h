@@ -1,0 +1,106 @@
+// The one generic ray cursor (STYLE.md habit 1): turns a structure's Region answers into the
+// stretches [t0, t1] of a ray that may hold visible samples, front to back.
+//
+// Exactness argument. The cursor only ever removes open intervals (s0, s1) that lie strictly
+// inside an empty region's box, shrunk by kMargin voxels on every side; positions computed in
+// float for any t there stay inside the box (float error << kMargin), so their trilinear cell is
+// one of the region's empty cells. Everything else of [t_near, t_far] is returned, so the ray
+// marcher (which rounds segments outward to lattice samples) takes every sample the reference
+// takes that could be visible. How the cursor walks (nudges, minimum advances) affects speed,
+// never the image.
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+#include "accel/region.h"
+
+namespace lacuna {
+
+struct Segment {
+    float t0, t1;  // world ray parameters; samples outside all segments are provably invisible
+};
+
+// A ray in index space: position(t) = o + t*d, t in world units.
+struct CursorRay {
+    float o[3], d[3];
+};
+
+// Structure S provides: Region region(const int cell[3], int& hint) const;  and
+// const int* cells() const (cells per axis, dims - 1).
+template <class S>
+class RegionCursor {
+public:
+    static constexpr float kMargin = 0.05f;  // voxels
+
+    RegionCursor(const S& s, const CursorRay& r, float t_near, float t_far)
+        : m_s(s), m_r(r), m_t(t_near), m_far(t_far), m_seg_start(t_near) {
+        float dmax = 0;
+        for (int a = 0; a < 3; ++a) dmax = std::max(dmax, std::abs(r.d[a]));
+        m_margin_t = kMargin / dmax;
+        m_nudge_t = 1e-3f / dmax;
+        const int* n = s.cells();
+        for (int a = 0; a < 3; ++a) {
+            m_hi[a] = float(n[a]);
+            m_last[a] = n[a] - 1;
+        }
+    }
+
+    // Next stretch that may hold visible samples; false when the ray is done.
+    bool next(Segment& out) {
+        while (m_t < m_far) {
+            // 1. The cell just past the current parameter (clamped like the sampler clamps).
+            const float tq = m_t + m_nudge_t;
+            int cell[3];
+            for (int a = 0; a < 3; ++a) {
+                float p = m_r.o[a] + tq * m_r.d[a];
+                p = p < 0.f ? 0.f : (p > m_hi[a] ? m_hi[a] : p);
+                cell[a] = std::min(int(p), m_last[a]);
+            }
+            // 2. Ask the structure; intersect the ray with the region's box.
+            const Region reg = m_s.region(cell, m_hint);
+            float ta = -INFINITY, tb = INFINITY;
+            for (int a = 0; a < 3; ++a) {
+                if (m_r.d[a] == 0.f) continue;
+                const float inv = 1.f / m_r.d[a];
+                float t0 = (float(reg.box.lo[a]) - m_r.o[a]) * inv;
+                float t1 = (float(reg.box.hi[a]) - m_r.o[a]) * inv;
+                if (t0 > t1) std::swap(t0, t1);
+                ta = std::max(ta, t0);
+                tb = std::min(tb, t1);
+            }
+            const float t_next = std::max(tb, m_t + m_nudge_t);
+            // 3. Empty: cut the interval strictly inside the box out of the ray.
+            if (reg.empty) {
+                const float s0 = std::max(ta, m_t) + m_margin_t, s1 = tb - m_margin_t;
+                m_t = t_next;
+                if (s1 > s0) {
+                    const Segment seg{m_seg_start, s0};
+                    m_seg_start = s1;
+                    if (seg.t1 > seg.t0) {
+                        out = seg;
+                        return true;
+                    }
+                }
+                continue;
+            }
+            // 4. Occupied: march on through it.
+            m_t = t_next;
+        }
+        if (m_done) return false;
+        m_done = true;
+        out = {m_seg_start, m_far};
+        return out.t1 > out.t0;
+    }
+
+private:
+    const S& m_s;
+    CursorRay m_r;
+    float m_t, m_far, m_seg_start;
+    float m_margin_t, m_nudge_t;
+    float m_hi[3];
+    int m_last[3];
+    int m_hint = -1;
+    bool m_done = false;
+};
+
+}  // namespace lacuna

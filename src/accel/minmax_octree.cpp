@@ -1,0 +1,51 @@
+#include "accel/minmax_octree.h"
+
+#include <chrono>
+
+namespace lacuna {
+
+MinMaxOctree::MinMaxOctree(const Volume& v, const AccelOptions& o)
+    : OctreeBase(AccelKind::MinMax, v, o) {
+    build();
+}
+
+void MinMaxOctree::build() {
+    const auto t0 = std::chrono::steady_clock::now();
+    m_nodes.assign(m_pyr.node_count(), Node{0xffff, 0});
+    // Leaves: union of their cells' ranges.
+    for_each_block_cells(m_volume, m_map, 1 << m_pyr.leaf_log2, m_opts.threads, [&](const BlockCells& b) {
+        const size_t n = size_t(b.n[0]) * b.n[1] * b.n[2];
+        uint16_t lo = 0xffff, hi = 0;
+        for (size_t c = 0; c < n; ++c) {
+            lo = std::min(lo, b.lo[c]);
+            hi = std::max(hi, b.hi[c]);
+        }
+        m_nodes[m_pyr.index(0, b.block[0], b.block[1], b.block[2])] = {lo, hi};
+    });
+    // Inner nodes: union of their children.
+    for (int l = 1; l < m_pyr.levels; ++l)
+        for (int z = 0; z < m_pyr.n[l][2]; ++z)
+            for (int y = 0; y < m_pyr.n[l][1]; ++y)
+                for (int x = 0; x < m_pyr.n[l][0]; ++x) {
+                    Node nd{0xffff, 0};
+                    m_pyr.for_children(l, x, y, z, [&](size_t c) {
+                        nd.lo = std::min(nd.lo, m_nodes[c].lo);
+                        nd.hi = std::max(nd.hi, m_nodes[c].hi);
+                    });
+                    m_nodes[m_pyr.index(l, x, y, z)] = nd;
+                }
+    m_stats.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_stats.nodes = m_nodes.size();
+    m_stats.bytes = m_nodes.size() * sizeof(Node);
+}
+
+void MinMaxOctree::set_transfer_function(const TransferLut& lut) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (needs_rebuild(lut)) build();
+    m_prefix.build(lut);
+    m_stats.tf_update_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace lacuna

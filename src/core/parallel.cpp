@@ -1,0 +1,44 @@
+#include "core/parallel.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <thread>
+
+namespace lacuna {
+
+int resolve_threads(int requested) {
+    int hw = int(std::thread::hardware_concurrency());
+    if (hw <= 0) hw = 1;
+    return requested > 0 ? requested : hw;
+}
+
+void parallel_for_tiles(int width, int height, int tile, int threads,
+                        const std::function<void(int, int, int, int)>& fn) {
+    const int tx = (width + tile - 1) / tile, ty = (height + tile - 1) / tile;
+    tbb::task_arena arena(resolve_threads(threads));
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, tx * ty, 1),
+            [&](const tbb::blocked_range<int>& r) {
+                for (int t = r.begin(); t != r.end(); ++t) {
+                    int x0 = (t % tx) * tile, y0 = (t / tx) * tile;
+                    fn(x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height));
+                }
+            },
+            tbb::simple_partitioner());
+    });
+}
+
+void parallel_for(size_t n, int threads, const std::function<void(size_t, size_t)>& fn,
+                  size_t grain) {
+    tbb::task_arena arena(resolve_threads(threads));
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain),
+                          [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); });
+    });
+}
+
+}  // namespace lacuna

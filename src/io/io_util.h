@@ -1,0 +1,80 @@
+// Helpers shared by the readers and writers in src/io/ (private to the library).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "lacuna/volume.h"
+
+namespace lacuna::io {
+
+std::string to_lower(std::string s);
+
+// The format-defining extension of a path, lowercased: ".nii.gz", ".nii", ".nrrd", ".nhdr",
+// ".mha", ".mhd", ".raw", ... ("" if the name has no dot).
+std::string format_extension(const std::string& path);
+
+// Throws Error(path, "file", ...) unless path names an existing, readable regular file.
+void check_readable_file(const std::string& path);
+// Throws Error(path, "output", "cannot write: <strerror>") unless path's directory exists and is
+// writable (the check is advisory; the real write reports its own failure).
+void check_writable_dir(const std::string& path);
+
+// Collapses a (possibly multi-line) library message into one trimmed line of at most
+// `max_chars` characters.
+std::string one_line(const std::string& text, size_t max_chars = 300);
+
+// A name for a temporary file beside `path` that keeps path's file name, and so its extension:
+// "dir/.tmp-<pid>-<n>-name.nii.gz". Companion files a writer derives from it (a detached
+// header's data file) share the prefix, so remove_temp_files can find them all.
+struct TempName {
+    std::string path;    // full temporary path
+    std::string prefix;  // ".tmp-<pid>-<n>-" (file-name prefix shared by companion files)
+    std::string dir;     // directory ("." when path has none)
+};
+TempName temp_name_beside(const std::string& path);
+// Removes every file in t.dir whose name starts with t.prefix (cleanup after a failed write).
+void remove_temp_files(const TempName& t) noexcept;
+// Renames `from` over `to`; throws Error(to, "output", ...) on failure.
+void rename_over(const std::string& from, const std::string& to);
+
+// Calls progress(f) if set; exceptions from the callback propagate.
+inline void report(const std::function<void(double)>& progress, double f) {
+    if (progress) progress(f);
+}
+
+// Voxel types as they may appear in files. Everything lacuna does not store natively is
+// converted on read: int8 -> int16, (u)int32/(u)int64/float64 -> float32.
+enum class DiskType : uint8_t { U8, I8, U16, I16, U32, I32, U64, I64, F32, F64 };
+size_t disk_type_size(DiskType t);
+std::string to_string(DiskType t);
+// The lacuna type a disk type is stored as (int8 widens to int16, wide types become float32).
+VoxelType stored_type(DiskType t);
+// The disk type whose bytes are exactly a lacuna voxel type.
+DiskType disk_type_of(VoxelType t);
+
+// Converts `count` voxels of disk type `src` at `in` to v's type, writing voxels
+// [first, first + count) of v. Applies value * slope + intercept when `rescale` is set (only
+// valid when v is float32). Byte order must already be native.
+void convert_voxels(DiskType src, const void* in, size_t count, Volume& v, size_t first,
+                    bool rescale = false, double slope = 1.0, double intercept = 0.0);
+
+// Reverses the byte order of `count` elements of `elem_size` bytes in place.
+void swap_bytes(void* data, size_t count, size_t elem_size);
+
+// Reads a voxel stream into v. `read(buf, n)` must fill up to n bytes and return how many it
+// read (fewer only at end of data); it may throw. Same-type data goes straight into v's
+// buffer; other types go through a small staging buffer, never a full-size copy. Throws
+// Error(where, "voxel data", "truncated: ...") when the stream ends early.
+void read_voxel_stream(const std::function<size_t(void*, size_t)>& read, DiskType disk, bool swap,
+                       Volume& v, const std::string& where,
+                       const std::function<void(double)>& progress, bool rescale = false,
+                       double slope = 1.0, double intercept = 0.0);
+
+inline bool host_is_big_endian() {
+    const uint16_t probe = 1;
+    return *reinterpret_cast<const uint8_t*>(&probe) == 0;
+}
+
+}  // namespace lacuna::io

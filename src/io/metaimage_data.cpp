@@ -1,0 +1,150 @@
+// MetaImage voxel data, read by our code after ITK has parsed the header.
+//
+// Why: MetaIO (ITK 5.2) accepts short or corrupt voxel data silently — it prints a complaint to
+// std::cerr and returns success, leaving the buffer partly unwritten. Reading the data here
+// lets truncation and corrupt compression become errors, and converts types through a small
+// staging buffer instead of a full-size temporary.
+//
+// Layouts handled: "ElementDataFile = LOCAL" (data follows the header line in the same file)
+// and one external data file, raw or zlib/gzip-compressed, with HeaderSize skip (-1 = data at
+// the end of the file). Slice lists and file-name patterns are left to MetaIO.
+#include "io/metaimage_data.h"
+
+#include <zlib.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "lacuna/error.h"
+
+namespace lacuna::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Offset of the first byte after the "ElementDataFile = LOCAL" line, or -1.
+int64_t local_data_offset(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string head(size_t(1) << 20, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(size_t(in.gcount()));
+    size_t pos = 0;
+    while (pos < head.size()) {
+        const size_t eol = head.find('\n', pos);
+        if (eol == std::string::npos) return -1;
+        const size_t key = head.find_first_not_of(" \t", pos);
+        if (key != std::string::npos && key < eol && head.compare(key, 15, "ElementDataFile") == 0)
+            return int64_t(eol + 1);
+        pos = eol + 1;
+    }
+    return -1;
+}
+
+// Streams inflated bytes out of a zlib or gzip stream.
+class Inflater {
+  public:
+    Inflater(std::ifstream& in, const std::string& where) : m_in(in), m_where(where) {
+        if (inflateInit2(&m_z, 15 + 32) != Z_OK)  // +32: accept zlib and gzip headers
+            throw Error(where, "voxel data", "cannot initialise zlib");
+    }
+    ~Inflater() { inflateEnd(&m_z); }
+    Inflater(const Inflater&) = delete;
+    Inflater& operator=(const Inflater&) = delete;
+
+    size_t read(void* out, size_t n) {
+        m_z.next_out = static_cast<Bytef*>(out);
+        m_z.avail_out = uInt(n);  // callers ask for at most 64 MiB at a time
+        while (m_z.avail_out > 0 && !m_done) {
+            if (m_z.avail_in == 0) {
+                m_in.read(reinterpret_cast<char*>(m_buf.data()), std::streamsize(m_buf.size()));
+                m_z.next_in = m_buf.data();
+                m_z.avail_in = uInt(m_in.gcount());
+                if (m_z.avail_in == 0) break;  // compressed stream cut short
+            }
+            const int rc = inflate(&m_z, Z_NO_FLUSH);
+            if (rc == Z_STREAM_END) {
+                m_done = true;
+            } else if (rc != Z_OK && rc != Z_BUF_ERROR) {
+                throw Error(m_where, "voxel data",
+                            std::string("corrupt compressed data: ") +
+                                (m_z.msg ? m_z.msg : "zlib error " + std::to_string(rc)));
+            }
+        }
+        return n - m_z.avail_out;
+    }
+
+  private:
+    std::ifstream& m_in;
+    std::string m_where;
+    z_stream m_z{};
+    std::vector<Bytef> m_buf = std::vector<Bytef>(size_t(1) << 20);
+    bool m_done = false;
+};
+
+}  // namespace
+
+std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,
+                                               const std::string& data_file, int header_size,
+                                               bool compressed, bool binary, bool msb,
+                                               size_t data_bytes) {
+    if (!binary) return std::nullopt;  // ASCII voxels: MetaIO parses them
+    MetaDataLayout l;
+    l.compressed = compressed;
+    l.swap = msb != host_is_big_endian();
+    if (data_file == "LOCAL") {
+        l.path = header_path;
+        l.offset = local_data_offset(header_path);
+        if (l.offset < 0) return std::nullopt;
+    } else {
+        if (data_file.empty() || data_file.rfind("LIST", 0) == 0 ||
+            data_file.find('%') != std::string::npos || data_file.find(' ') != std::string::npos)
+            return std::nullopt;
+        const fs::path p(data_file);
+        l.path = p.is_absolute() ? p.string() : (fs::path(header_path).parent_path() / p).string();
+        l.offset = 0;
+    }
+    std::error_code ec;
+    const uint64_t size = fs::file_size(l.path, ec);
+    if (ec)
+        throw Error(header_path, "voxel data",
+                    "cannot open the data file " + fs::path(l.path).filename().string() + ": " +
+                        ec.message());
+    if (header_size > 0) l.offset += header_size;
+    if (header_size == -1 && !compressed) l.offset = int64_t(size) - int64_t(data_bytes);
+    if (!compressed && (l.offset < 0 || size < uint64_t(l.offset) + data_bytes))
+        throw Error(header_path, "voxel data",
+                    "truncated: expected " + std::to_string(data_bytes) +
+                        " bytes of voxels, the data file has " +
+                        std::to_string(l.offset < 0 || size < uint64_t(l.offset)
+                                           ? 0
+                                           : size - uint64_t(l.offset)));
+    return l;
+}
+
+void read_metaimage_voxels(const MetaDataLayout& l, DiskType disk, Volume& v,
+                           const std::string& where, const std::function<void(double)>& progress) {
+    std::ifstream in(l.path, std::ios::binary);
+    if (!in)
+        throw Error(
+            where, "voxel data",
+            "cannot open " + fs::path(l.path).filename().string() + ": " + std::strerror(errno));
+    in.seekg(l.offset);
+    if (l.compressed) {
+        Inflater inflater(in, where);
+        read_voxel_stream([&](void* buf, size_t n) { return inflater.read(buf, n); }, disk, l.swap,
+                          v, where, progress);
+    } else {
+        read_voxel_stream(
+            [&](void* buf, size_t n) {
+                in.read(static_cast<char*>(buf), std::streamsize(n));
+                if (in.bad()) throw Error(where, "voxel data", "read error");
+                return size_t(in.gcount());
+            },
+            disk, l.swap, v, where, progress);
+    }
+}
+
+}  // namespace lacuna::io

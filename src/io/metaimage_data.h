@@ -1,0 +1,32 @@
+// Where a MetaImage's voxels live and how to read them (see metaimage_data.cpp).
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "io/io_util.h"
+#include "lacuna/volume.h"
+
+namespace lacuna::io {
+
+struct MetaDataLayout {
+    std::string path;    // file holding the voxels
+    int64_t offset = 0;  // first voxel byte (of the compressed stream when compressed)
+    bool compressed = false;
+    bool swap = false;  // file byte order differs from the host's
+};
+
+// Locates the voxel data described by a parsed MetaImage header; nullopt for layouts left to
+// MetaIO. For uncompressed data, throws Error(header_path, "voxel data", "truncated: ...")
+// when the file is shorter than `data_bytes` — before anything is allocated.
+std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,
+                                               const std::string& data_file, int header_size,
+                                               bool compressed, bool binary, bool msb,
+                                               size_t data_bytes);
+
+// Reads (inflating if needed) the voxels into v, converting from `disk`.
+void read_metaimage_voxels(const MetaDataLayout& layout, DiskType disk, Volume& v,
+                           const std::string& where, const std::function<void(double)>& progress);
+
+}  // namespace lacuna::io

@@ -1,0 +1,410 @@
+// NIfTI-1 and NIfTI-2 single-file reader (.nii, .nii.gz).
+//
+// Why not ITK: ITK 5.2's NiftiImageIO only knows NIfTI-1, and its Read() loads the whole image
+// into niftilib's own buffer and then copies it into ours (a second full-size copy). The format
+// is small enough to parse directly: a fixed binary header, then voxels at vox_offset.
+// zlib's gz* functions read gzip-compressed and plain files alike.
+//
+// Header layouts (byte offsets; NIfTI-1 header is 348 bytes, NIfTI-2 is 540):
+//   field        NIfTI-1          NIfTI-2
+//   sizeof_hdr   0   int32        0   int32
+//   magic        344 char[4]      4   char[8]
+//   datatype     70  int16        12  int16
+//   dim[8]       40  int16        16  int64
+//   pixdim[8]    76  float        104 double
+//   vox_offset   108 float        168 int64
+//   scl_slope    112 float        176 double
+//   scl_inter    116 float        184 double
+//   qform_code   252 int16        344 int32
+//   sform_code   254 int16        348 int32
+//   quatern_bcd  256 float[3]     352 double[3]
+//   qoffset_xyz  268 float[3]     376 double[3]
+//   srow_x/y/z   280 float[4]x3   400 double[4]x3
+//
+// Geometry is chosen as ITK's NiftiImageIO chooses it (see set_geometry) and converted from NIfTI's
+// RAS+ world to ITK's LPS+ (negate x and y), so origin/direction agree with ITK-based tools and
+// with the NRRD/MetaImage readers.
+#include <zlib.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+#include "io/io_util.h"
+#include "io/readers.h"
+#include "lacuna/error.h"
+
+namespace lacuna::io {
+
+namespace {
+
+struct GzCloser {
+    void operator()(gzFile_s* f) const { gzclose(f); }
+};
+using GzFile = std::unique_ptr<gzFile_s, GzCloser>;
+
+struct NiftiHeader {
+    int version = 1;
+    bool swap = false;
+    int64_t dim[8] = {};
+    int datatype = 0;
+    double pixdim[8] = {};
+    int64_t vox_offset = 0;
+    double slope = 0, inter = 0;
+    int qform_code = 0, sform_code = 0;
+    double quatern[3] = {}, qoffset[3] = {};
+    double srow[3][4] = {};
+};
+
+// Reads a T at byte `off` of the header, fixing byte order.
+template <class T>
+T get(const uint8_t* buf, size_t off, bool swap) {
+    T v;
+    std::memcpy(&v, buf + off, sizeof(T));
+    if (swap) swap_bytes(&v, 1, sizeof(T));
+    return v;
+}
+
+// gzerror's text, without the "<path>: " it starts with.
+std::string zlib_reason(const char* msg, const std::string& path) {
+    std::string s = msg ? msg : "zlib error";
+    if (s.rfind(path + ": ", 0) == 0) s.erase(0, path.size() + 2);
+    return one_line(s);
+}
+
+// Fills `out` from the stream; returns the number of bytes read. Treats a truncated gzip
+// member as end of data (the caller reports truncation with byte counts); throws on corrupt
+// compressed data.
+size_t gz_read_all(gzFile f, void* out, size_t n, const std::string& path) {
+    auto* dst = static_cast<uint8_t*>(out);
+    size_t done = 0;
+    while (done < n) {
+        // gzread takes an unsigned int; stay well inside it.
+        const unsigned want = unsigned(std::min<size_t>(n - done, size_t(1) << 30));
+        const int got = gzread(f, dst + done, want);
+        if (got < 0) {
+            int code = 0;
+            const char* msg = gzerror(f, &code);
+            if (code == Z_BUF_ERROR) break;  // "unexpected end of file": truncated
+            throw Error(path, "voxel data", "corrupt compressed data: " + zlib_reason(msg, path));
+        }
+        if (got == 0) {
+            int code = 0;
+            const char* msg = gzerror(f, &code);
+            if (code != Z_OK && code != Z_BUF_ERROR)
+                throw Error(path, "voxel data",
+                            "corrupt compressed data: " + zlib_reason(msg, path));
+            break;
+        }
+        done += size_t(got);
+    }
+    return done;
+}
+
+NiftiHeader parse_header(gzFile f, const std::string& path) {
+    uint8_t buf[540] = {};
+    const size_t got = gz_read_all(f, buf, 348, path);
+    if (got < 4) throw Error(path, "header", "not a NIfTI file (file is too short)");
+    NiftiHeader h;
+    const int32_t size_native = get<int32_t>(buf, 0, false);
+    const int32_t size_swapped = get<int32_t>(buf, 0, true);
+    if (size_native == 348 || size_native == 540) {
+        h.version = size_native == 348 ? 1 : 2;
+    } else if (size_swapped == 348 || size_swapped == 540) {
+        h.version = size_swapped == 348 ? 1 : 2;
+        h.swap = true;
+    } else {
+        throw Error(path, "header",
+                    "not a NIfTI file (header size field is " + std::to_string(size_native) +
+                        ", expected 348 or 540)");
+    }
+    const size_t hdr_size = h.version == 1 ? 348 : 540;
+    size_t have = got;
+    if (h.version == 2 && have == 348) have += gz_read_all(f, buf + 348, 540 - 348, path);
+    if (have < hdr_size)
+        throw Error(path, "header",
+                    "truncated: a NIfTI-" + std::to_string(h.version) + " header needs " +
+                        std::to_string(hdr_size) + " bytes, the file has " + std::to_string(have));
+    const bool s = h.swap;
+    if (h.version == 1) {
+        const char* magic = reinterpret_cast<const char*>(buf + 344);
+        if (std::memcmp(magic, "ni1\0", 4) == 0)
+            throw Error(path, "header",
+                        "two-file NIfTI (.hdr/.img pair) is not supported; convert to .nii");
+        if (std::memcmp(magic, "n+1\0", 4) != 0)
+            throw Error(path, "header",
+                        "not a NIfTI-1 file (magic 'n+1' missing; Analyze 7.5 is not supported)");
+        for (int i = 0; i < 8; ++i) h.dim[i] = get<int16_t>(buf, 40 + 2 * i, s);
+        h.datatype = get<int16_t>(buf, 70, s);
+        for (int i = 0; i < 8; ++i) h.pixdim[i] = get<float>(buf, 76 + 4 * i, s);
+        const double off = get<float>(buf, 108, s);
+        if (!std::isfinite(off) || off < 0 || off > 1e15)
+            throw Error(path, "header", "invalid vox_offset " + std::to_string(off));
+        h.vox_offset = int64_t(off);
+        h.slope = get<float>(buf, 112, s);
+        h.inter = get<float>(buf, 116, s);
+        h.qform_code = get<int16_t>(buf, 252, s);
+        h.sform_code = get<int16_t>(buf, 254, s);
+        for (int i = 0; i < 3; ++i) h.quatern[i] = get<float>(buf, 256 + 4 * i, s);
+        for (int i = 0; i < 3; ++i) h.qoffset[i] = get<float>(buf, 268 + 4 * i, s);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) h.srow[r][c] = get<float>(buf, 280 + 16 * r + 4 * c, s);
+    } else {
+        const char* magic = reinterpret_cast<const char*>(buf + 4);
+        if (std::memcmp(magic, "ni2\0", 4) == 0)
+            throw Error(path, "header",
+                        "two-file NIfTI (.hdr/.img pair) is not supported; convert to .nii");
+        if (std::memcmp(magic, "n+2\0", 4) != 0)
+            throw Error(path, "header", "not a NIfTI-2 file (magic 'n+2' missing)");
+        h.datatype = get<int16_t>(buf, 12, s);
+        for (int i = 0; i < 8; ++i) h.dim[i] = get<int64_t>(buf, 16 + 8 * i, s);
+        for (int i = 0; i < 8; ++i) h.pixdim[i] = get<double>(buf, 104 + 8 * i, s);
+        h.vox_offset = get<int64_t>(buf, 168, s);
+        h.slope = get<double>(buf, 176, s);
+        h.inter = get<double>(buf, 184, s);
+        h.qform_code = get<int32_t>(buf, 344, s);
+        h.sform_code = get<int32_t>(buf, 348, s);
+        for (int i = 0; i < 3; ++i) h.quatern[i] = get<double>(buf, 352 + 8 * i, s);
+        for (int i = 0; i < 3; ++i) h.qoffset[i] = get<double>(buf, 376 + 8 * i, s);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) h.srow[r][c] = get<double>(buf, 400 + 32 * r + 8 * c, s);
+    }
+    if (h.vox_offset < int64_t(hdr_size))
+        throw Error(path, "header",
+                    "vox_offset " + std::to_string(h.vox_offset) +
+                        " points inside the header (expected >= " + std::to_string(hdr_size) + ")");
+    return h;
+}
+
+// NIfTI datatype codes (nifti1.h) -> disk type; throws for non-scalar or exotic types.
+DiskType disk_type_from(int datatype, const std::string& path) {
+    switch (datatype) {
+        case 2:
+            return DiskType::U8;
+        case 4:
+            return DiskType::I16;
+        case 8:
+            return DiskType::I32;
+        case 16:
+            return DiskType::F32;
+        case 64:
+            return DiskType::F64;
+        case 256:
+            return DiskType::I8;
+        case 512:
+            return DiskType::U16;
+        case 768:
+            return DiskType::U32;
+        case 1024:
+            return DiskType::I64;
+        case 1280:
+            return DiskType::U64;
+        case 128:
+            throw Error(path, "datatype", "expected a scalar image, got 3 components (RGB24)");
+        case 2304:
+            throw Error(path, "datatype", "expected a scalar image, got 4 components (RGBA32)");
+        case 32:
+        case 1792:
+        case 2048:
+            throw Error(path, "datatype",
+                        "complex voxels are not supported (NIfTI datatype " +
+                            std::to_string(datatype) + ")");
+        case 1536:
+            throw Error(path, "datatype", "float128 voxels are not supported");
+        default:
+            throw Error(path, "datatype",
+                        "unknown NIfTI datatype code " + std::to_string(datatype));
+    }
+}
+
+Vec3i checked_dims(const NiftiHeader& h, const std::string& path) {
+    const int64_t nd = h.dim[0];
+    if (nd < 1 || nd > 7)
+        throw Error(path, "header", "dim[0] is " + std::to_string(nd) + ", expected 1..7");
+    if (nd < 3)
+        throw Error(path, "dims", "expected a 3D volume, got a " + std::to_string(nd) + "D image");
+    for (int i = 4; i <= nd; ++i) {
+        if (h.dim[i] == 1) continue;
+        if (i == 5)
+            throw Error(path, "dims",
+                        "expected a scalar image, got " + std::to_string(h.dim[5]) + " components");
+        throw Error(path, "dims",
+                    "expected a 3D volume, got dim[" + std::to_string(i) + "] = " +
+                        std::to_string(h.dim[i]) + " (a " + std::to_string(nd) + "D image)");
+    }
+    for (int a = 1; a <= 3; ++a) {
+        if (h.dim[a] < 2 || h.dim[a] > kMaxDim)
+            throw Error(path, "dims",
+                        "expected 2.." + std::to_string(kMaxDim) + " voxels per axis, got " +
+                            std::to_string(h.dim[1]) + "x" + std::to_string(h.dim[2]) + "x" +
+                            std::to_string(h.dim[3]));
+    }
+    return {int(h.dim[1]), int(h.dim[2]), int(h.dim[3])};
+}
+
+double positive_or_one(double s) {
+    return std::isfinite(s) && s > 0 ? s : 1.0;
+}
+
+// A NIfTI voxel-to-world affine (RAS+): world = m * (i, j, k) + t.
+struct Affine {
+    double m[3][3] = {};
+    double t[3] = {};
+    double column_norm(int c) const {
+        return std::sqrt(m[0][c] * m[0][c] + m[1][c] * m[1][c] + m[2][c] * m[2][c]);
+    }
+};
+
+// The qform as a matrix (nifti1_io.c: nifti_quatern_to_mat44), scaled by pixdim.
+Affine qform_affine(const NiftiHeader& h) {
+    double b = h.quatern[0], c = h.quatern[1], d = h.quatern[2];
+    double a = 1.0 - (b * b + c * c + d * d);
+    if (a < 1e-7) {
+        a = 1.0 / std::sqrt(b * b + c * c + d * d);
+        b *= a;
+        c *= a;
+        d *= a;
+        a = 0.0;
+    } else {
+        a = std::sqrt(a);
+    }
+    const double qfac = h.pixdim[0] < 0 ? -1.0 : 1.0;
+    const double r[3][3] = {
+        {a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
+        {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
+        {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
+    const double scale[3] = {positive_or_one(std::fabs(h.pixdim[1])),
+                             positive_or_one(std::fabs(h.pixdim[2])),
+                             qfac * positive_or_one(std::fabs(h.pixdim[3]))};
+    Affine q;
+    for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 3; ++col) q.m[row][col] = r[row][col] * scale[col];
+        q.t[row] = h.qoffset[row];
+    }
+    return q;
+}
+
+Affine sform_affine(const NiftiHeader& h) {
+    Affine s;
+    for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 3; ++col) s.m[row][col] = h.srow[row][col];
+        s.t[row] = h.srow[row][3];
+    }
+    return s;
+}
+
+bool finite_affine(const Affine& a) {
+    for (int row = 0; row < 3; ++row) {
+        if (!std::isfinite(a.t[row])) return false;
+        for (int col = 0; col < 3; ++col)
+            if (!std::isfinite(a.m[row][col])) return false;
+    }
+    return true;
+}
+
+// True when the 3x3 part is a rotation times per-axis scales (orthonormal once the columns are
+// normalised): the only kind of matrix an origin + direction + spacing can represent.
+bool is_rigid(const Affine& s) {
+    if (!finite_affine(s)) return false;
+    double n[3];
+    for (int c = 0; c < 3; ++c) {
+        n[c] = s.column_norm(c);
+        if (!(n[c] > 0)) return false;
+    }
+    for (int a = 0; a < 3; ++a)
+        for (int b = a + 1; b < 3; ++b) {
+            const double d = s.m[0][a] * s.m[0][b] + s.m[1][a] * s.m[1][b] + s.m[2][a] * s.m[2][b];
+            if (std::fabs(d) > 1e-4 * n[a] * n[b]) return false;
+        }
+    return true;
+}
+
+bool similar(const Affine& a, const Affine& b, double tol) {
+    for (int row = 0; row < 3; ++row) {
+        if (std::fabs(a.t[row] - b.t[row]) > tol) return false;
+        for (int col = 0; col < 3; ++col)
+            if (std::fabs(a.m[row][col] - b.m[row][col]) > tol) return false;
+    }
+    return true;
+}
+
+// Sets spacing, origin and direction (LPS+) from the header, choosing between qform and sform
+// the way ITK's NiftiImageIO does, so a file reads the same here as in ITK-based tools:
+//   neither code set                       -> origin 0, identity direction
+//   sform rigid and (qform unknown, or sform_code SCANNER_ANAT, or sform ~= qform) -> sform
+//   otherwise, qform code set              -> qform
+//   otherwise (only a sheared sform)       -> the sform with normalised columns
+// Spacing always comes from pixdim, as in ITK.
+void set_geometry(const NiftiHeader& h, Volume& v) {
+    v.spacing = {positive_or_one(std::fabs(h.pixdim[1])), positive_or_one(std::fabs(h.pixdim[2])),
+                 positive_or_one(std::fabs(h.pixdim[3]))};
+    const bool have_q =
+        h.qform_code > 0 && std::isfinite(h.quatern[0] + h.quatern[1] + h.quatern[2]);
+    const bool have_s = h.sform_code > 0 && finite_affine(sform_affine(h));
+    if (!have_q && !have_s) {
+        v.origin = {0, 0, 0};
+        for (int i = 0; i < 9; ++i) v.direction[i] = i % 4 == 0 ? 1.0 : 0.0;
+        return;
+    }
+    const Affine q = qform_affine(h), s = sform_affine(h);
+    bool use_s = false;
+    if (have_s && is_rigid(s)) {
+        constexpr int kScannerAnat = 1;
+        use_s = !have_q || h.sform_code == kScannerAnat || similar(q, s, 1e-4);
+    }
+    const Affine& m = use_s || !have_q ? s : q;
+    // RAS+ -> LPS+: flip the first two world axes. "+ 0.0" turns -0 into 0 for printouts.
+    const double flip[3] = {-1.0, -1.0, 1.0};
+    for (int col = 0; col < 3; ++col) {
+        const double n = m.column_norm(col);
+        for (int row = 0; row < 3; ++row)
+            v.direction[row * 3 + col] = (n > 0 ? flip[row] * m.m[row][col] / n : 0.0) + 0.0;
+    }
+    for (int row = 0; row < 3; ++row)
+        v.origin[row] = (std::isfinite(m.t[row]) ? flip[row] * m.t[row] : 0.0) + 0.0;
+}
+
+}  // namespace
+
+Volume read_nifti(const std::string& path, const ReadOptions& opts) {
+    GzFile f(gzopen(path.c_str(), "rb"));
+    if (!f) throw Error(path, "file", std::string("cannot open: ") + std::strerror(errno));
+    gzbuffer(f.get(), 1u << 20);
+    const NiftiHeader h = parse_header(f.get(), path);
+    const Vec3i dims = checked_dims(h, path);
+    const DiskType disk = disk_type_from(h.datatype, path);
+
+    // NIfTI: slope 0 (or non-finite) means "no scaling"; scaled data is float, as in ITK.
+    const bool rescale = std::isfinite(h.slope) && std::isfinite(h.inter) && h.slope != 0.0 &&
+                         (h.slope != 1.0 || h.inter != 0.0);
+    const VoxelType type = rescale ? VoxelType::Float32 : stored_type(disk);
+    const size_t data_bytes =
+        size_t(dims.x) * size_t(dims.y) * size_t(dims.z) * disk_type_size(disk);
+
+    // An uncompressed file's length is known: report truncation before allocating.
+    if (gzdirect(f.get())) {
+        std::error_code ec;
+        const auto file_bytes = std::filesystem::file_size(path, ec);
+        if (!ec && file_bytes < uint64_t(h.vox_offset) + data_bytes)
+            throw Error(path, "voxel data",
+                        "truncated: expected " + std::to_string(data_bytes) +
+                            " bytes of voxels after offset " + std::to_string(h.vox_offset) +
+                            ", the file has " +
+                            std::to_string(file_bytes > uint64_t(h.vox_offset)
+                                               ? file_bytes - uint64_t(h.vox_offset)
+                                               : 0));
+    }
+
+    Volume v(dims, type, path);
+    set_geometry(h, v);
+    if (gzseek(f.get(), z_off_t(h.vox_offset), SEEK_SET) != z_off_t(h.vox_offset))
+        throw Error(path, "voxel data",
+                    "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
+    read_voxel_stream([&](void* buf, size_t n) { return gz_read_all(f.get(), buf, n, path); }, disk,
+                      h.swap, v, path, opts.progress, rescale, h.slope, h.inter);
+    return v;
+}
+
+}  // namespace lacuna::io

@@ -1,0 +1,73 @@
+// read_volume / write_volume: pick the format from the path, hand over to one reader or
+// writer, and make sure nothing but lacuna::Error (one line, naming the file) escapes.
+#include <filesystem>
+#include <new>
+
+#include "io/io_util.h"
+#include "io/readers.h"
+#include "lacuna/error.h"
+#include "lacuna/io.h"
+
+namespace lacuna {
+
+Volume read_volume(const std::string& path, const ReadOptions& opts) {
+    io::report(opts.progress, 0.0);
+    Volume v;
+    try {
+        std::error_code ec;
+        if (!path.empty() && std::filesystem::is_directory(path, ec)) {
+            v = io::read_dicom_dir(path, opts);
+        } else {
+            io::check_readable_file(path);
+            const std::string ext = io::format_extension(path);
+            if (ext == ".nii" || ext == ".nii.gz")
+                v = io::read_nifti(path, opts);
+            else if (ext == ".raw")
+                v = io::read_raw(path, opts);
+            else if (ext == ".hdr" || ext == ".img" || ext == ".img.gz")
+                throw Error(path, "format",
+                            "Analyze/NIfTI .hdr/.img pairs are not supported; convert to .nii");
+            else
+                v = io::read_itk(path, opts);
+        }
+        v.compute_range(path);
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw Error(path, "memory", "out of memory while reading");
+    } catch (const std::exception& e) {
+        throw Error(path, "read", io::one_line(e.what()));
+    }
+    io::report(opts.progress, 1.0);
+    return v;
+}
+
+void write_volume(const std::string& path, const Volume& v) {
+    if (!v.data()) throw Error(path, "output", "the volume is empty");
+    try {
+        if (!path.empty() && path.back() == '/') {
+            io::write_dicom_dir(path, v);
+            return;
+        }
+        const std::string ext = io::format_extension(path);
+        if (ext == ".raw") {
+            io::write_raw(path, v);
+        } else if (ext == ".nrrd" || ext == ".nhdr" || ext == ".nii" || ext == ".nii.gz" ||
+                   ext == ".mha" || ext == ".mhd") {
+            io::write_itk(path, v);
+        } else {
+            throw Error(path, "output",
+                        "unknown extension '" + ext +
+                            "', expected .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd, .raw or a "
+                            "directory ending in '/'");
+        }
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw Error(path, "memory", "out of memory while writing");
+    } catch (const std::exception& e) {
+        throw Error(path, "output", io::one_line(e.what()));
+    }
+}
+
+}  // namespace lacuna

@@ -1,0 +1,171 @@
+#include "lacuna/renderer.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "accel/accel_impl.h"
+#include "core/parallel.h"
+#include "lacuna/error.h"
+#include "render/ray_march_kernel.h"
+
+namespace lacuna {
+
+std::string to_string(const RenderStats& s) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "%.1f ms, %llu samples, %.1f samples/ray, %.1f Msamples/s", s.seconds * 1e3,
+                  (unsigned long long)s.samples, s.samples_per_ray(), s.msamples_per_second());
+    return buf;
+}
+
+std::vector<Rgba> step_corrected_lut(const TransferLut& lut, float step) {
+    std::vector<Rgba> out(lut.entries.size());
+    for (size_t e = 0; e < out.size(); ++e) {
+        const Rgba& c = lut.entries[e];
+        // Zero stays exactly zero (skipping relies on it); pow keeps 1 at 1.
+        const float a = c.a <= 0.f ? 0.f : 1.f - std::pow(1.f - std::min(c.a, 1.f), step);
+        out[e] = {c.r * a, c.g * a, c.b * a, a};
+    }
+    return out;
+}
+
+RayMarcher::RayMarcher(const Volume& volume) : m_volume(volume) {}
+RayMarcher::~RayMarcher() = default;
+
+void RayMarcher::set_transfer_function(const TransferLut& lut) { m_lut = lut; }
+
+Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; }
+
+namespace {
+
+// Slab test of a ray against the index-space box [0, hi]. Returns false on a miss.
+bool intersect_box(const kernel::IndexRay& r, Vec3f hi, float& t0, float& t1) {
+    t0 = 0.f;
+    t1 = INFINITY;
+    const float o[3] = {r.ox, r.oy, r.oz}, d[3] = {r.dx, r.dy, r.dz};
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.f) {
+            if (o[a] < 0.f || o[a] > hi[a]) return false;
+            continue;
+        }
+        const float inv = 1.f / d[a];
+        float ta = (0.f - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    return t0 < t1;
+}
+
+template <class T, class Index, class S>
+void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
+                 const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
+                 RenderResult& out, std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+    const Vec3i d = vol.dims();
+    kernel::Grid<T, Index> g{data,
+                      ptrdiff_t(d.x),
+                      ptrdiff_t(d.x) * ptrdiff_t(d.y),
+                      float(d.x - 1),
+                      float(d.y - 1),
+                      float(d.z - 1),
+                      d.x - 2,
+                      d.y - 2,
+                      d.z - 2};
+    const Vec3f inv_sp{float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y),
+                       float(1.0 / vol.spacing.z)};
+    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
+    const float dt = opt.step * min_sp;
+    const Vec3f hi{g.hi_x, g.hi_y, g.hi_z};
+    uint64_t tile_samples = 0, tile_rays = 0;
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            const Ray wr = cam.generate(float(x), float(y));
+            const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
+            const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+            kernel::Accum acc;
+            uint32_t n = 0;
+            float t_near, t_far;
+            if (intersect_box(r, hi, t_near, t_far)) {
+                ++tile_rays;
+                // Number of lattice samples with t_k < t_far.
+                const int k_end = std::max(int(std::ceil((t_far - t_near) / dt - 0.5f)), 0);
+                // The structure's stretches, rounded outward to lattice samples: a few extra
+                // reference samples may be taken, a visible one is never missed.
+                typename S::Cursor cursor(accel, CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}},
+                                          t_near, t_far);
+                Segment seg;
+                bool done = false;
+                int k = 0;
+                while (!done && k < k_end && cursor.next(seg)) {
+                    const int kb = std::max(k, int(std::floor((seg.t0 - t_near) / dt - 0.5f)));
+                    const int ke =
+                        std::min(k_end, int(std::floor((seg.t1 - t_near) / dt - 0.5f)) + 2);
+                    if (ke > kb)
+                        n += kernel::march(g, r, t_near, dt, kb, ke, lut.data(), map, opt.ert,
+                                           acc, done);
+                    k = std::max(k, ke);
+                }
+            }
+            tile_samples += n;
+            const float w = 1.f - acc.a;
+            uint8_t* px = out.image.pixel(x, y);
+            const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
+                                  acc.b + w * opt.background.z};
+            for (int c = 0; c < 3; ++c)
+                px[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
+            px[3] = 255;
+            if (opt.keep_float) {
+                float* f = &out.rgba_float[(size_t(y) * size_t(out.image.width) + x) * 4];
+                f[0] = acc.r, f[1] = acc.g, f[2] = acc.b, f[3] = acc.a;
+            }
+            if (opt.count_samples) out.sample_counts[size_t(y) * size_t(out.image.width) + x] = n;
+        }
+    }
+    samples += tile_samples;
+    rays += tile_rays;
+}
+
+}  // namespace
+
+RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) const {
+    if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
+    if (!(opt.step > 0.f) || !std::isfinite(opt.step))
+        throw Error("--step", "step", "expected a positive number");
+    if (cam.width() < 1 || cam.height() < 1)
+        throw Error("--size", "image size", "expected at least 1x1 pixels");
+    RenderResult out;
+    out.image = Image(cam.width(), cam.height());
+    if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);
+    if (opt.keep_float) out.rgba_float.assign(size_t(cam.width()) * cam.height() * 4, 0.f);
+    const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
+    const ValueToLut map = m_lut.map();
+    std::atomic<uint64_t> samples{0}, rays{0};
+    const auto t0 = std::chrono::steady_clock::now();
+    visit_voxels(m_volume, [&](const auto* data) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
+        const bool small = m_volume.voxel_count() < (size_t(1) << 31);
+        static const NoAccel kNone;
+        visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
+            parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                               [&](int x0, int y0, int x1, int y1) {
+                                   if (small)
+                                       render_tile<T, int32_t>(s, m_volume, data, cam, opt, lut,
+                                                               map, x0, y0, x1, y1, out, samples,
+                                                               rays);
+                                   else
+                                       render_tile<T, int64_t>(s, m_volume, data, cam, opt, lut,
+                                                               map, x0, y0, x1, y1, out, samples,
+                                                               rays);
+                               });
+        });
+    });
+    const auto t1 = std::chrono::steady_clock::now();
+    out.stats.seconds = std::chrono::duration<double>(t1 - t0).count();
+    out.stats.samples = samples;
+    out.stats.rays = rays;
+    out.stats.pixels = uint64_t(cam.width()) * cam.height();
+    return out;
+}
+
+}  // namespace lacuna

@@ -1,0 +1,188 @@
+// Built-in transfer functions and the "--tf" resolver. One line per preset in
+// docs/transfer-functions.md; keep the two in step.
+//
+// All presets are in the normalized domain: x = 0 is the visualization range's minimum, x = 1
+// its maximum. Each has exactly zero opacity below x = 0.1 (background air), so empty-space
+// skipping always has something to skip. Opacity is per unit sample distance (one voxel).
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "lacuna/error.h"
+#include "lacuna/transfer_function.h"
+
+namespace lacuna {
+
+namespace {
+
+// CT presets assume the visualization range is -1024..3071 HU (12-bit CT with the usual
+// rescale intercept of -1024). hu() places a Hounsfield value on that normalized axis, rounded
+// to 4 decimals (< 0.5 HU) so the presets read cleanly as JSON ("0.2867", not 17 digits).
+constexpr double kHuMin = -1024.0, kHuMax = 3071.0;
+double hu(double v) {
+    return std::round((v - kHuMin) / (kHuMax - kHuMin) * 1e4) / 1e4;
+}
+
+TransferFunction make(std::string name, std::vector<ColorPoint> color,
+                      std::vector<OpacityPoint> opacity) {
+    TransferFunction tf;
+    tf.name = std::move(name);
+    tf.domain = TfDomain::Normalized;
+    tf.color = std::move(color);
+    tf.opacity = std::move(opacity);
+    return tf;
+}
+
+// Opaque above bone density: transparent up to 150 HU (soft tissue, contrast-enhanced blood),
+// ramping through trabecular bone (~300 HU) to nearly opaque cortical bone (>= 1000 HU).
+TransferFunction ct_bone() {
+    return make("ct-bone",
+                {{0.0, 0.55f, 0.25f, 0.15f},
+                 {hu(150), 0.55f, 0.25f, 0.15f},
+                 {hu(400), 0.9f, 0.82f, 0.68f},
+                 {hu(1000), 1.0f, 0.97f, 0.9f},
+                 {1.0, 1.0f, 1.0f, 1.0f}},
+                {{0.0, 0.f}, {hu(150), 0.f}, {hu(400), 0.6f}, {hu(1000), 0.9f}, {1.0, 0.9f}});
+}
+
+// The skin/air boundary: air (-1000 HU) is transparent, everything denser than -400 HU is an
+// opaque skin-coloured shell (lungs stay hidden behind it).
+TransferFunction ct_skin() {
+    return make("ct-skin",
+                {{0.0, 0.7f, 0.45f, 0.35f},
+                 {hu(-600), 0.7f, 0.45f, 0.35f},
+                 {hu(-400), 0.93f, 0.72f, 0.6f},
+                 {hu(200), 0.95f, 0.76f, 0.65f},
+                 {hu(1000), 1.0f, 0.95f, 0.9f},
+                 {1.0, 1.0f, 0.95f, 0.9f}},
+                {{0.0, 0.f}, {hu(-600), 0.f}, {hu(-400), 0.8f}, {1.0, 0.85f}});
+}
+
+// Fat (~-100 HU, yellow, faint), a dip at water, muscle (~40..60 HU, red, moderate), and a
+// moderate white for bone so the skeleton gives context without hiding the muscles.
+TransferFunction ct_soft_tissue() {
+    return make("ct-soft-tissue",
+                {{0.0, 0.8f, 0.65f, 0.35f},
+                 {hu(-250), 0.8f, 0.65f, 0.35f},
+                 {hu(-100), 0.95f, 0.8f, 0.45f},
+                 {hu(-20), 0.85f, 0.45f, 0.35f},
+                 {hu(60), 0.78f, 0.25f, 0.2f},
+                 {hu(200), 0.9f, 0.6f, 0.5f},
+                 {hu(700), 1.0f, 0.95f, 0.9f},
+                 {1.0, 1.0f, 1.0f, 1.0f}},
+                {{0.0, 0.f},
+                 {hu(-250), 0.f},
+                 {hu(-100), 0.08f},
+                 {hu(-20), 0.03f},
+                 {hu(60), 0.3f},
+                 {hu(200), 0.15f},
+                 {hu(700), 0.5f},
+                 {1.0, 0.5f}});
+}
+
+// MRI presets are tuned on a T1 head such as mricron's ch2 (uint8): background ~0-0.04,
+// CSF dark, grey matter mid-range, white matter brighter, scalp and fat brightest.
+
+// A generic grey ramp: zero up to 0.1, then linear to a moderate 0.35.
+TransferFunction mr_default() {
+    return make("mr-default",
+                {{0.0, 0.25f, 0.25f, 0.28f}, {0.5, 0.7f, 0.7f, 0.7f}, {1.0, 1.0f, 0.98f, 0.95f}},
+                {{0.0, 0.f}, {0.1, 0.f}, {1.0, 0.35f}});
+}
+
+// The head's outer surface as an opaque skin-coloured shell: transparent up to 0.12,
+// ramping to nearly opaque by 0.2.
+TransferFunction mr_skin() {
+    return make("mr-skin",
+                {{0.0, 0.55f, 0.3f, 0.25f},
+                 {0.12, 0.75f, 0.5f, 0.4f},
+                 {0.2, 0.93f, 0.72f, 0.6f},
+                 {0.6, 0.98f, 0.8f, 0.7f},
+                 {1.0, 1.0f, 0.9f, 0.82f}},
+                {{0.0, 0.f}, {0.12, 0.f}, {0.2, 0.85f}, {1.0, 0.9f}});
+}
+
+// Skull-stripped brains (ch2bet, ch2better): background and CSF transparent, grey matter pink
+// and translucent, white matter cream and denser.
+TransferFunction mr_brain() {
+    return make("mr-brain",
+                {{0.0, 0.6f, 0.3f, 0.3f},
+                 {0.3, 0.8f, 0.45f, 0.45f},
+                 {0.45, 0.92f, 0.6f, 0.6f},
+                 {0.65, 1.0f, 0.9f, 0.78f},
+                 {1.0, 1.0f, 0.97f, 0.9f}},
+                {{0.0, 0.f}, {0.15, 0.f}, {0.3, 0.05f}, {0.45, 0.15f}, {0.65, 0.3f}, {1.0, 0.45f}});
+}
+
+// An opacity gap like the vessel TF of the bitfield paper's Figure 3: a translucent low-mid
+// band (0.12..0.34), exactly zero over [0.34, 0.61] (brain tissue switched off), and visible
+// again at the top (bright vessels and fat). Exercises skipping across a TF with holes.
+TransferFunction mr_gap() {
+    return make("mr-gap",
+                {{0.0, 0.6f, 0.5f, 0.45f},
+                 {0.18, 0.9f, 0.75f, 0.6f},
+                 {0.34, 0.9f, 0.75f, 0.6f},
+                 {0.61, 0.9f, 0.2f, 0.15f},
+                 {1.0, 1.0f, 0.5f, 0.4f}},
+                {{0.0, 0.f},
+                 {0.12, 0.f},
+                 {0.18, 0.12f},
+                 {0.3, 0.12f},
+                 {0.34, 0.f},
+                 {0.61, 0.f},
+                 {0.7, 0.35f},
+                 {1.0, 0.6f}});
+}
+
+struct PresetEntry {
+    const char* name;
+    TransferFunction (*make)();
+};
+constexpr PresetEntry kPresets[] = {
+    {"ct-bone", ct_bone},       {"ct-skin", ct_skin}, {"ct-soft-tissue", ct_soft_tissue},
+    {"mr-default", mr_default}, {"mr-skin", mr_skin}, {"mr-brain", mr_brain},
+    {"mr-gap", mr_gap},
+};
+
+std::string joined_names() {
+    std::string s;
+    for (const PresetEntry& p : kPresets) s += (s.empty() ? "" : ", ") + std::string(p.name);
+    return s;
+}
+
+const PresetEntry* find_preset(const std::string& name) {
+    for (const PresetEntry& p : kPresets)
+        if (name == p.name) return &p;
+    return nullptr;
+}
+
+}  // namespace
+
+std::vector<std::string> preset_names() {
+    std::vector<std::string> names;
+    for (const PresetEntry& p : kPresets) names.emplace_back(p.name);
+    return names;
+}
+
+TransferFunction preset(const std::string& name) {
+    if (const PresetEntry* p = find_preset(name)) return p->make();
+    throw Error("transfer function", "preset",
+                "unknown preset '" + name + "'; expected one of: " + joined_names());
+}
+
+TransferFunction resolve_transfer_function(const std::string& spec) {
+    if (const PresetEntry* p = find_preset(spec)) return p->make();
+    std::string lower = spec;
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    std::error_code ec;
+    const bool json_name = lower.ends_with(".json");
+    if (json_name || std::filesystem::is_regular_file(spec, ec))
+        return load_transfer_function(spec);
+    throw Error(
+        "--tf", "preset",
+        "unknown preset '" + spec + "'; expected one of: " + joined_names() + " or a .json file");
+}
+
+}  // namespace lacuna

@@ -1,0 +1,165 @@
+// The CLI end to end: good runs produce files and timing lines; every bad input gives one line
+// naming the file and the problem, exit code 2, and leaves no output file behind.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+    int code = -1;
+    std::string out, err;
+};
+
+fs::path temp_dir() {
+    static fs::path dir = [] {
+        fs::path d = fs::temp_directory_path() /
+                     ("lacuna-cli-" + std::to_string(::getpid()));
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+CliRun run(const std::string& args) {
+    const fs::path out = temp_dir() / "stdout.txt", err = temp_dir() / "stderr.txt";
+    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" + out.string() +
+                            " 2>" + err.string() + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    CliRun r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+// One line, mentioning `needle`, exit code 2.
+void expect_one_line_error(const CliRun& r, const std::string& needle) {
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than one line: " << r.err;
+}
+
+const fs::path& small_volume() {
+    static fs::path p = [] {
+        fs::path v = temp_dir() / "shells.nrrd";
+        CliRun r = run("generate sphere-shells --dims 33x30x27 --out " + v.string());
+        EXPECT_EQ(r.code, 0) << r.err;
+        return v;
+    }();
+    return p;
+}
+
+TEST(Cli, RendersAGeneratedVolumeAndReportsTiming) {
+    const fs::path png = temp_dir() / "shells.png", heat = temp_dir() / "shells-heat.png";
+    CliRun r = run("render " + small_volume().string() + " --tf mr-default --size 64 --out " +
+                png.string() + " --heatmap " + heat.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("render time"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("samples/ray"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Msamples/s"), std::string::npos) << r.out;
+    EXPECT_TRUE(fs::exists(png));
+    EXPECT_TRUE(fs::exists(heat));
+    EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
+}
+
+TEST(Cli, InfoDescribesTheCh2Head) {
+    CliRun r = run("info /usr/share/mricron/templates/ch2.nii.gz");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("181 x 217 x 181"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("uint8"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("histogram"), std::string::npos) << r.out;
+}
+
+TEST(Cli, MissingVolumeIsOneLineExit2) {
+    const fs::path png = temp_dir() / "never.png";
+    CliRun r = run("render /nonexistent/head.nii.gz --tf mr-skin --out " + png.string());
+    expect_one_line_error(r, "/nonexistent/head.nii.gz");
+    EXPECT_FALSE(fs::exists(png));
+}
+
+TEST(Cli, UnknownPresetIsOneLineExit2) {
+    const fs::path png = temp_dir() / "never.png";
+    CliRun r = run("render " + small_volume().string() + " --tf no-such-preset --out " + png.string());
+    expect_one_line_error(r, "no-such-preset");
+    EXPECT_FALSE(fs::exists(png));
+}
+
+TEST(Cli, MalformedTfJsonIsOneLineExit2) {
+    const fs::path tf = temp_dir() / "broken.json", png = temp_dir() / "never.png";
+    std::ofstream(tf) << "{\"color\": [[0, 1, 1, 1]], \"opacity\": [[0, 0.5], [0.5,";
+    CliRun r = run("render " + small_volume().string() + " --tf " + tf.string() + " --out " +
+                png.string());
+    expect_one_line_error(r, "broken.json");
+    EXPECT_FALSE(fs::exists(png));
+}
+
+TEST(Cli, UnwritableOutputIsOneLineExit2) {
+    CliRun r = run("render " + small_volume().string() +
+                " --tf mr-default --size 16 --out /nonexistent-dir/out.png");
+    expect_one_line_error(r, "/nonexistent-dir/out.png");
+    fs::path ro = temp_dir() / "readonly";
+    fs::create_directories(ro);
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    // root ignores permission bits; the check only means something for other users.
+    if (::geteuid() != 0) {
+        CliRun r2 = run("render " + small_volume().string() + " --tf mr-default --size 16 --out " +
+                     (ro / "out.png").string());
+        expect_one_line_error(r2, "out.png");
+    }
+    fs::permissions(ro, fs::perms::owner_all);
+}
+
+TEST(Cli, BadOptionsAreOneLineExit2) {
+    const std::string v = small_volume().string();
+    expect_one_line_error(run("render " + v + " --tf mr-skin --accel octopus --out x.png"),
+                          "octopus");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --step -1 --out x.png"), "--step");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --size 0 --out x.png"), "--size");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --out x.jpg"), "x.jpg");
+    expect_one_line_error(run("generate tree --dims 12x12 --out x.nrrd"), "--dims");
+    expect_one_line_error(run("generate tree --dims 100000x100000x100000 --out x.nrrd"), "dims");
+    expect_one_line_error(run("generate teapot --out x.nrrd"), "teapot");
+    expect_one_line_error(run("render --frobnicate"), "frobnicate");
+    EXPECT_FALSE(fs::exists("x.png"));
+    EXPECT_FALSE(fs::exists("x.nrrd"));
+}
+
+TEST(Cli, TruncatedVolumeIsOneLineExit2AndInputUntouched) {
+    const std::string full = slurp("/usr/share/mricron/templates/ch2.nii.gz");
+    const fs::path cut = temp_dir() / "cut.nii.gz", png = temp_dir() / "never.png";
+    std::ofstream(cut, std::ios::binary) << full.substr(0, full.size() / 2);
+    const std::string before = slurp(cut);
+    CliRun r = run("render " + cut.string() + " --tf mr-skin --size 16 --out " + png.string());
+    expect_one_line_error(r, "cut.nii.gz");
+    EXPECT_EQ(slurp(cut), before);
+    EXPECT_FALSE(fs::exists(png));
+}
+
+TEST(Cli, RawVolumeWithExplicitLayout) {
+    const fs::path raw = temp_dir() / "ramp.raw", png = temp_dir() / "ramp.png";
+    std::string bytes(12 * 10 * 8, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i % 200);
+    std::ofstream(raw, std::ios::binary) << bytes;
+    CliRun ok = run("render " + raw.string() +
+                 " --dims 12x10x8 --type uint8 --tf mr-default --size 16 --out " + png.string());
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    CliRun bad = run("info " + raw.string() + " --dims 12x10x9 --type uint8");
+    expect_one_line_error(bad, "ramp.raw");
+}
+
+}  // namespace

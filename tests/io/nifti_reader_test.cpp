@@ -1,0 +1,115 @@
+// The NIfTI reader on hand-built headers: NIfTI-2, byte order, type conversions, scaling,
+// 4D files with one time point. (The real templates are covered in volume_reader_test.cpp.)
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "io/io_test_util.h"
+#include "io/nifti_test_file.h"
+#include "lacuna/io.h"
+
+namespace lacuna {
+namespace {
+
+using test::NiftiSpec;
+using test::ScratchDir;
+
+TEST(IoNifti, ReadsNifti2WithSform) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.version = 2;
+    spec.dims = {4, 3, 2};
+    spec.datatype = 512;  // uint16
+    spec.pixdim = {2, 3, 4};
+    spec.sform_code = 1;
+    spec.srow = {{{2, 0, 0, 10}, {0, 3, 0, 20}, {0, 0, 4, 30}}};
+    std::vector<uint16_t> vox(24);
+    for (size_t i = 0; i < vox.size(); ++i) vox[i] = uint16_t(1000 + i);
+    const std::string path = dir.file("two.nii");
+    test::write_bytes(path, test::nifti_bytes(spec, vox.data(), vox.size() * 2));
+    const Volume v = read_volume(path);
+    EXPECT_EQ(v.dims(), (Vec3i{4, 3, 2}));
+    EXPECT_EQ(v.type(), VoxelType::UInt16);
+    EXPECT_EQ(v.spacing, (Vec3d{2, 3, 4}));
+    EXPECT_EQ(v.origin, (Vec3d{-10, -20, 30}));  // RAS -> LPS
+    EXPECT_EQ(v.value(3, 2, 1), 1023.f);
+    EXPECT_EQ(v.data_range().min, 1000.f);
+}
+
+TEST(IoNifti, ReadsBigEndianNifti1) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.dims = {3, 3, 3};
+    spec.datatype = 4;  // int16
+    spec.big_endian = true;
+    std::vector<int16_t> vox(27);
+    for (size_t i = 0; i < vox.size(); ++i) vox[i] = int16_t(-300 + 25 * int(i));
+    std::vector<int16_t> be = vox;
+    for (auto& x : be) x = int16_t(uint16_t(x) >> 8 | uint16_t(x) << 8);
+    const std::string path = dir.file("be.nii");
+    test::write_bytes(path, test::nifti_bytes(spec, be.data(), be.size() * 2));
+    const Volume v = read_volume(path);
+    ASSERT_EQ(v.type(), VoxelType::Int16);
+    EXPECT_EQ(std::memcmp(v.data(), vox.data(), vox.size() * 2), 0);
+}
+
+TEST(IoNifti, WidensInt8ToInt16) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.dims = {2, 2, 2};
+    spec.datatype = 256;  // int8
+    const int8_t vox[8] = {-128, -1, 0, 1, 2, 3, 64, 127};
+    const std::string path = dir.file("i8.nii");
+    test::write_bytes(path, test::nifti_bytes(spec, vox, sizeof vox));
+    const Volume v = read_volume(path);
+    ASSERT_EQ(v.type(), VoxelType::Int16);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(v.data_as<int16_t>()[i], vox[i]);
+}
+
+TEST(IoNifti, ConvertsFloat64AndInt32ToFloat32) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.dims = {2, 2, 2};
+    spec.datatype = 64;  // float64
+    const double d[8] = {-1.5, 0, 0.25, 1e6, 3, 4, 5, 6};
+    test::write_bytes(dir.file("f64.nii"), test::nifti_bytes(spec, d, sizeof d));
+    const Volume v = read_volume(dir.file("f64.nii"));
+    ASSERT_EQ(v.type(), VoxelType::Float32);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(v.data_as<float>()[i], float(d[i]));
+
+    spec.datatype = 8;  // int32
+    const int32_t n[8] = {-100000, 0, 1, 2, 3, 4, 5, 16777216};
+    test::write_bytes(dir.file("i32.nii.gz"), test::gzip(test::nifti_bytes(spec, n, sizeof n)));
+    const Volume w = read_volume(dir.file("i32.nii.gz"));
+    ASSERT_EQ(w.type(), VoxelType::Float32);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(w.data_as<float>()[i], float(n[i]));
+}
+
+TEST(IoNifti, AppliesSlopeAndInterceptAsFloat) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.dims = {2, 2, 2};
+    spec.datatype = 2;  // uint8
+    spec.slope = 0.5;
+    spec.inter = -10;
+    const uint8_t vox[8] = {0, 1, 2, 3, 4, 100, 200, 255};
+    test::write_bytes(dir.file("s.nii"), test::nifti_bytes(spec, vox, sizeof vox));
+    const Volume v = read_volume(dir.file("s.nii"));
+    ASSERT_EQ(v.type(), VoxelType::Float32);
+    for (int i = 0; i < 8; ++i) EXPECT_FLOAT_EQ(v.data_as<float>()[i], vox[i] * 0.5f - 10.f);
+}
+
+TEST(IoNifti, AcceptsFourthDimensionOfOne) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.ndim = 4;
+    spec.dims = {3, 2, 2};
+    spec.datatype = 2;
+    const uint8_t vox[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+    test::write_bytes(dir.file("t1.nii"), test::nifti_bytes(spec, vox, sizeof vox));
+    EXPECT_EQ(read_volume(dir.file("t1.nii")).dims(), (Vec3i{3, 2, 2}));
+}
+
+}  // namespace
+}  // namespace lacuna
