@@ -1,0 +1,257 @@
+// The conformance suite: every skipping structure gives the image of --accel none, byte for byte
+// (and the float accumulations bit for bit), and never takes more samples. It runs over every
+// AccelKind, so a new structure is covered by adding it to the enum.
+//
+// Cases: adversarial synthetic volumes (thin sheets, 0/max checkerboards, values on bin
+// boundaries, odd dims), the real mricron datasets, and randomized volumes / TFs with
+// single-entry opacity spikes / cameras inside and outside the volume, with and without ERT,
+// and with every octree setting (leaf size, bit width, initial level, top-down).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <random>
+
+#include "lacuna/accel.h"
+#include "lacuna/io.h"
+#include "lacuna/renderer.h"
+#include "lacuna/synthetic.h"
+#include "lacuna/transfer_function.h"
+
+namespace lacuna {
+namespace {
+
+// Deterministic generator for the randomized cases (std distributions are not portable).
+struct Rng {
+    uint64_t s;
+    uint64_t next() {
+        uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    float uniform() { return float(next() >> 40) / float(1 << 24); }
+    int range(int lo, int hi) { return lo + int(next() % uint64_t(hi - lo + 1)); }
+};
+
+struct Case {
+    std::string name;
+    const Volume* volume;
+    TransferLut lut;
+    Camera camera;
+    RenderOptions options;
+    AccelOptions accel;
+};
+
+// Renders the case with every structure and compares with none.
+void expect_all_structures_exact(const Case& c, std::vector<AccelKind> kinds = all_accel_kinds()) {
+    RayMarcher m(*c.volume);
+    m.set_transfer_function(c.lut);
+    RenderOptions o = c.options;
+    o.keep_float = true;
+    o.count_samples = true;
+    const RenderResult ref = m.render(c.camera, o);
+    for (AccelKind k : kinds) {
+        if (k == AccelKind::None) continue;
+        auto accel = make_accel(k, *c.volume, c.accel);
+        accel->set_transfer_function(c.lut);
+        m.set_accel(accel.get());
+        const RenderResult r = m.render(c.camera, o);
+        m.set_accel(nullptr);
+        ASSERT_EQ(r.image.rgba, ref.image.rgba) << c.name << " accel " << to_string(k);
+        ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
+                                 ref.rgba_float.size() * sizeof(float)))
+            << c.name << " accel " << to_string(k) << ": float accumulations differ";
+        ASSERT_LE(r.stats.samples, ref.stats.samples) << c.name << " accel " << to_string(k);
+    }
+}
+
+// A LUT that is transparent except for one entry (the sharpest test of a structure).
+TransferLut spike_lut(ValueRange vis, int entry, float opacity = 0.7f) {
+    TransferLut lut;
+    lut.vis = vis;
+    lut.entries.assign(kDefaultLutSize, Rgba{});
+    lut.entries[size_t(entry)] = {0.9f, 0.6f, 0.3f, opacity};
+    return lut;
+}
+
+// A random piecewise TF: a few random opacity bumps with zero between them.
+TransferLut random_lut(ValueRange vis, Rng& rng) {
+    TransferLut lut;
+    lut.vis = vis;
+    lut.entries.assign(kDefaultLutSize, Rgba{});
+    const int bumps = rng.range(1, 4);
+    for (int b = 0; b < bumps; ++b) {
+        const int c = rng.range(0, kDefaultLutSize - 1), w = rng.range(0, 40);
+        const float a = 0.05f + 0.9f * rng.uniform();
+        for (int e = std::max(0, c - w); e <= std::min(kDefaultLutSize - 1, c + w); ++e)
+            lut.entries[size_t(e)] = {rng.uniform(), rng.uniform(), rng.uniform(), a};
+    }
+    return lut;
+}
+
+Camera random_camera(const Volume& v, Rng& rng, int size) {
+    OrbitParams p;
+    p.azimuth_deg = 360.f * rng.uniform();
+    p.elevation_deg = -80.f + 160.f * rng.uniform();
+    p.projection = rng.range(0, 3) == 0 ? Projection::Orthographic : Projection::Perspective;
+    const Box3f b{{0, 0, 0}, v.world_extent()};
+    if (p.projection == Projection::Perspective && rng.range(0, 2) == 0) {
+        // Inside the volume: a target in the box and a short distance.
+        p.has_target = true;
+        p.target = {b.hi.x * rng.uniform(), b.hi.y * rng.uniform(), b.hi.z * rng.uniform()};
+        p.distance = 0.05f + 0.3f * length(b.extent()) * rng.uniform();
+        p.fov_y_deg = 40.f + 60.f * rng.uniform();
+    } else {
+        p.zoom = 0.7f + 2.f * rng.uniform();
+    }
+    return Camera::orbit(b, p, size, size);
+}
+
+TEST(Conformance, AdversarialSyntheticVolumesAreExactForEveryStructure) {
+    const SyntheticKind kinds[] = {SyntheticKind::ThinSheets, SyntheticKind::Checkerboard,
+                                   SyntheticKind::BinBoundaries, SyntheticKind::Tree,
+                                   SyntheticKind::SphereShells, SyntheticKind::NoiseBlobs,
+                                   SyntheticKind::MarschnerLobb};
+    const VoxelType types[] = {VoxelType::UInt8, VoxelType::Int16, VoxelType::UInt16,
+                               VoxelType::Float32};
+    Rng rng{42};
+    for (SyntheticKind kind : kinds)
+        for (VoxelType type : types) {
+            SyntheticOptions so;
+            so.dims = {rng.range(9, 41), rng.range(9, 41), rng.range(9, 41)};
+            so.type = type;
+            so.seed = uint32_t(rng.next());
+            const Volume v = generate(kind, so);
+            const ValueToLut map(v.vis_range(), kDefaultLutSize);
+            // Spikes exactly on the entries of the data's extreme and middle values, plus a
+            // random multi-bump TF.
+            const int entries[] = {map(v.data_range().max), map(v.data_range().min) + 1,
+                                   map(0.5f * (v.data_range().min + v.data_range().max))};
+            for (int e : entries) {
+                Case c{to_string(kind) + "/" + to_string(type) + "/spike" + std::to_string(e), &v,
+                       spike_lut(v.vis_range(), std::min(e, kDefaultLutSize - 1)),
+                       random_camera(v, rng, 40), RenderOptions{}, AccelOptions{}};
+                c.options.ert = rng.range(0, 1) ? 0.99f : 2.f;
+                c.options.step = 0.2f + rng.uniform();
+                expect_all_structures_exact(c);
+            }
+            Case c{to_string(kind) + "/" + to_string(type) + "/random", &v,
+                   random_lut(v.vis_range(), rng), random_camera(v, rng, 40), RenderOptions{},
+                   AccelOptions{}};
+            expect_all_structures_exact(c);
+        }
+}
+
+TEST(Conformance, RandomVolumesTfsAndCamerasAreExact) {
+    Rng rng{7};
+    for (int trial = 0; trial < 40; ++trial) {
+        const Vec3i dims{rng.range(2, 37), rng.range(2, 37), rng.range(2, 37)};
+        const VoxelType type = VoxelType(rng.range(0, 3));
+        Volume v(dims, type);
+        // Sparse random content: mostly the minimum, a few random-valued voxels and blobs.
+        const float hi = type == VoxelType::UInt8 ? 255.f : (type == VoxelType::Float32 ? 1.f : 4000.f);
+        const int points = rng.range(1, 60);
+        for (int p = 0; p < points; ++p) {
+            const int x = rng.range(0, dims.x - 1), y = rng.range(0, dims.y - 1),
+                      z = rng.range(0, dims.z - 1);
+            const float val = type == VoxelType::Float32 ? hi * rng.uniform()
+                                                         : std::floor(hi * rng.uniform());
+            v.set_value(x, y, z, val);
+        }
+        v.set_value(0, 0, 0, hi);  // a known range
+        v.compute_range();
+        AccelOptions ao;
+        ao.leaf_cells = 1 << rng.range(1, 4);
+        ao.bitfield_bits = 8 << rng.range(0, 4);
+        ao.bidirectional = rng.range(0, 1) == 1;
+        ao.initial_level = rng.range(-1, 3);
+        ao.distance_block = rng.range(1, 5);
+        TransferLut lut;
+        if (rng.range(0, 1)) {
+            // A spike on the entry of one of the voxels we set (so something is visible).
+            lut = spike_lut(v.vis_range(), ValueToLut(v.vis_range(), kDefaultLutSize)(
+                                               v.value(rng.range(0, dims.x - 1), 0, 0)));
+            lut.entries[size_t(ValueToLut(v.vis_range(), kDefaultLutSize)(hi))].a = 0.4f;
+        } else {
+            lut = random_lut(v.vis_range(), rng);
+        }
+        Case c{"random trial " + std::to_string(trial), &v, lut, random_camera(v, rng, 32),
+               RenderOptions{}, ao};
+        c.options.step = 0.1f + 1.5f * rng.uniform();
+        c.options.ert = rng.range(0, 1) ? 0.9f : 2.f;
+        expect_all_structures_exact(c);
+    }
+}
+
+TEST(Conformance, RealDatasetsAreExactForEveryStructure) {
+    const std::string dir = "/usr/share/mricron/templates/";
+    struct Real {
+        const char* file;
+        const char* preset;
+    };
+    const Real reals[] = {{"ch2.nii.gz", "mr-skin"},
+                          {"ch2bet.nii.gz", "mr-brain"},
+                          {"ch2.nii.gz", "mr-gap"},
+                          {"inia19-t1-brain.nii.gz", "mr-brain"},
+                          {"aal.nii.gz", "mr-default"}};
+    Rng rng{99};
+    for (const Real& r : reals) {
+        const Volume v = read_volume(dir + r.file);
+        const TransferLut lut = discretise(preset(r.preset), v.vis_range());
+        for (int view = 0; view < 2; ++view) {
+            Case c{std::string(r.file) + "/" + r.preset + "/view" + std::to_string(view), &v, lut,
+                   random_camera(v, rng, 48), RenderOptions{}, AccelOptions{}};
+            c.options.ert = view == 0 ? 0.99f : 2.f;
+            expect_all_structures_exact(c);
+        }
+    }
+}
+
+TEST(Conformance, EveryOctreeSettingIsExact) {
+    SyntheticOptions so;
+    so.dims = {45, 38, 51};
+    const Volume v = generate(SyntheticKind::Tree, so);
+    const TransferLut lut = discretise(preset("mr-gap"), v.vis_range());
+    Rng rng{5};
+    const Camera cam = random_camera(v, rng, 40);
+    for (int leaf : {2, 4, 8, 16, 32, 64})
+        for (int bits : {8, 16, 32, 64, 128})
+            for (int level : {-1, 0, 1, 2}) {
+                AccelOptions ao;
+                ao.leaf_cells = leaf;
+                ao.bitfield_bits = bits;
+                ao.initial_level = level;
+                ao.bidirectional = (leaf + bits + level) % 2 == 0;
+                Case c{"leaf " + std::to_string(leaf) + " bits " + std::to_string(bits) +
+                           " level " + std::to_string(level),
+                       &v, lut, cam, RenderOptions{}, ao};
+                expect_all_structures_exact(c, {AccelKind::Bitfield, AccelKind::MinMax,
+                                                AccelKind::Boolean});
+            }
+}
+
+TEST(Conformance, StructuresSkipSamplesOnSparseVolumes) {
+    // Not a timing test: the structures must actually remove samples where space is empty.
+    SyntheticOptions so;
+    so.dims = {64, 64, 64};
+    const Volume v = generate(SyntheticKind::Tree, so);
+    const TransferLut lut = discretise(preset("mr-default"), v.vis_range());
+    RayMarcher m(v);
+    m.set_transfer_function(lut);
+    OrbitParams p;
+    const Camera cam = Camera::orbit(m.bounds(), p, 48, 48);
+    const uint64_t none = m.render(cam, RenderOptions{}).stats.samples;
+    for (AccelKind k : all_accel_kinds()) {
+        if (k == AccelKind::None) continue;
+        auto a = make_accel(k, v);
+        a->set_transfer_function(lut);
+        m.set_accel(a.get());
+        const uint64_t s = m.render(cam, RenderOptions{}).stats.samples;
+        EXPECT_LT(s * 2, none) << to_string(k) << " took " << s << " of " << none;
+        m.set_accel(nullptr);
+    }
+}
+
+}  // namespace
+}  // namespace lacuna
