@@ -47,5 +47,6 @@ private:
 void register_info(CLI::App& app);
 void register_render(CLI::App& app);
 void register_generate(CLI::App& app);
+void register_bench(CLI::App& app);
 
 }  // namespace lacuna::cli

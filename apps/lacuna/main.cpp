@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     lacuna::cli::register_info(app);
     lacuna::cli::register_render(app);
     lacuna::cli::register_generate(app);
+    lacuna::cli::register_bench(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
