@@ -1,12 +1,15 @@
-// `lacuna render`: one frame of a volume to a PNG, with timing and sample statistics.
+// `lacuna render`: one frame of a volume to a PNG, with timing and sample statistics; or, with
+// --tf-animate, a sequence while the TF moves between two TFs (bitfield paper, Section 4.5),
+// reporting per structure the time from a TF change to ready-to-render.
 #include <cstdio>
+#include <filesystem>
 
 #include "cli_common.h"
+#include "core/parallel.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
-#include "core/parallel.h"
 
 namespace lacuna::cli {
 
@@ -22,6 +25,8 @@ struct RenderArgs {
     VolumeArgs volume;
     bool demo = false;
     std::string tf;
+    std::vector<std::string> tf_animate;
+    int frames = 36;
     std::string accel = "none";
     std::string out;
     std::string heatmap;
@@ -45,7 +50,37 @@ Vec3f parse_rgb(const std::string& s) {
     return c;
 }
 
-void run(RenderArgs& a) {
+// "--accel all" or a comma-separated list.
+std::vector<AccelKind> parse_accels(const std::string& s) {
+    if (s == "all") return all_accel_kinds();
+    std::vector<AccelKind> out;
+    size_t pos = 0;
+    for (;;) {
+        const size_t c = s.find(',', pos);
+        out.push_back(parse_accel(s.substr(pos, c == std::string::npos ? std::string::npos : c - pos)));
+        if (c == std::string::npos) break;
+        pos = c + 1;
+    }
+    return out;
+}
+
+// Frame i of an animation written beside `out`: head.png -> head_007.png.
+std::string frame_path(const std::string& out, int i) {
+    namespace fs = std::filesystem;
+    fs::path p(out);
+    char num[16];
+    std::snprintf(num, sizeof num, "_%03d", i);
+    return (p.parent_path() / (p.stem().string() + num + p.extension().string())).string();
+}
+
+struct Setup {
+    RenderOptions ro;
+    AccelOptions ao;
+    OrbitParams op;
+    int w = 0, h = 0;
+};
+
+Setup validate(RenderArgs& a) {
     if (a.demo) {
         if (a.volume.path.empty()) a.volume.path = kDemoVolume;
         if (a.tf.empty()) a.tf = kDemoTf;
@@ -54,63 +89,129 @@ void run(RenderArgs& a) {
         if (!a.elevation_given) a.elevation = kDemoElevation;
     }
     if (a.volume.path.empty()) throw Error("render", "volume", "expected a volume file (or --demo)");
-    if (a.tf.empty()) throw Error("render", "--tf", "expected a preset name or a .json file");
+    if (a.tf.empty() && a.tf_animate.empty())
+        throw Error("render", "--tf", "expected a preset name or a .json file");
     if (a.out.empty()) throw Error("render", "--out", "expected an output .png file");
-    // Everything that can be checked before the slow work is checked first.
-    const AccelKind accel_kind = parse_accel(a.accel);
     check_output_path(a.out, ".png");
     if (!a.heatmap.empty()) check_output_path(a.heatmap, ".png");
-    const TransferFunction tf = resolve_transfer_function(a.tf);
-    const int w = a.width > 0 ? a.width : a.size, h = a.height > 0 ? a.height : a.size;
-    if (w < 1 || h < 1 || w > 16384 || h > 16384)
+    Setup s;
+    s.w = a.width > 0 ? a.width : a.size;
+    s.h = a.height > 0 ? a.height : a.size;
+    if (s.w < 1 || s.h < 1 || s.w > 16384 || s.h > 16384)
         throw Error("--size", "image size", "expected 1..16384 pixels per side");
     if (!(a.step > 0.f && a.step <= 64.f)) throw Error("--step", "step", "expected 0 < step <= 64");
     if (!(a.ert > 0.f && a.ert <= 1.f)) throw Error("--ert", "threshold", "expected 0 < ert <= 1");
-    RenderOptions ro;
-    ro.step = a.step;
-    ro.ert = a.ert >= 1.f ? 2.f : a.ert;  // 1 means off: opacity never reaches 2
-    ro.threads = a.threads;
-    ro.background = parse_rgb(a.background);
-    ro.count_samples = !a.heatmap.empty();
+    if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
+    s.ro.step = a.step;
+    s.ro.ert = a.ert >= 1.f ? 2.f : a.ert;  // 1 means off: opacity never reaches 2
+    s.ro.threads = a.threads;
+    s.ro.background = parse_rgb(a.background);
+    s.ro.count_samples = !a.heatmap.empty();
+    s.ao.leaf_cells = a.leaf;
+    s.ao.bitfield_bits = a.bits;
+    s.ao.initial_level = a.initial_level;
+    s.ao.bidirectional = !a.top_down;
+    s.ao.threads = a.threads;
+    s.op.azimuth_deg = a.azimuth;
+    s.op.elevation_deg = a.elevation;
+    s.op.zoom = a.zoom;
+    s.op.fov_y_deg = a.fov;
+    s.op.projection = a.ortho ? Projection::Orthographic : Projection::Perspective;
+    return s;
+}
 
-    Volume vol = load_volume(a.volume);
+std::unique_ptr<Accel> build_accel(AccelKind k, const Volume& vol, const AccelOptions& ao) {
+    Progress progress("building " + to_string(k));
+    auto accel = make_accel(k, vol, ao);
+    progress.done();
+    return accel;
+}
+
+void print_accel(AccelKind k, const Accel& accel) {
+    if (k == AccelKind::None) return;
+    const AccelStats& st = accel.stats();
+    std::printf("accel %s: build %.1f ms, TF update %.3f ms, %zu nodes, %.2f MiB\n",
+                to_string(k).c_str(), st.build_seconds * 1e3, st.tf_update_seconds * 1e3, st.nodes,
+                double(st.bytes) / (1 << 20));
+}
+
+void render_one(const RenderArgs& a, const Setup& s) {
+    const AccelKind kind = parse_accel(a.accel);
+    const TransferFunction tf = resolve_transfer_function(a.tf);
+    const Volume vol = load_volume(a.volume);
     const TransferLut lut = discretise(tf, vol.vis_range());
-    AccelOptions ao;
-    ao.leaf_cells = a.leaf;
-    ao.bitfield_bits = a.bits;
-    ao.initial_level = a.initial_level;
-    ao.bidirectional = !a.top_down;
-    ao.threads = a.threads;
-    Progress build_progress("building " + a.accel);
-    std::unique_ptr<Accel> accel = make_accel(accel_kind, vol, ao);
+    auto accel = build_accel(kind, vol, s.ao);
     accel->set_transfer_function(lut);
-    build_progress.done();
     RayMarcher marcher(vol);
     marcher.set_transfer_function(lut);
     marcher.set_accel(accel.get());
-    OrbitParams op;
-    op.azimuth_deg = a.azimuth;
-    op.elevation_deg = a.elevation;
-    op.zoom = a.zoom;
-    op.fov_y_deg = a.fov;
-    op.projection = a.ortho ? Projection::Orthographic : Projection::Perspective;
-    const Camera cam = Camera::orbit(marcher.bounds(), op, w, h);
-    RenderResult r = marcher.render(cam, ro);
+    const Camera cam = Camera::orbit(marcher.bounds(), s.op, s.w, s.h);
+    const RenderResult r = marcher.render(cam, s.ro);
     write_png(a.out, r.image);
-    if (!a.heatmap.empty()) write_png(a.heatmap, heatmap(r.sample_counts, w, h));
-    std::printf("%s: %dx%d %s, tf %s, accel %s, %d threads\n", a.volume.path.c_str(), w, h,
+    if (!a.heatmap.empty()) write_png(a.heatmap, heatmap(r.sample_counts, s.w, s.h));
+    std::printf("%s: %dx%d %s, tf %s, accel %s, %d threads\n", a.volume.path.c_str(), s.w, s.h,
                 a.ortho ? "orthographic" : "perspective", tf.name.c_str(), a.accel.c_str(),
                 resolve_threads(a.threads));
-    if (accel_kind != AccelKind::None) {
-        const AccelStats& st = accel->stats();
-        std::printf("accel %s: build %.1f ms, TF update %.3f ms, %zu nodes, %.2f MiB\n",
-                    a.accel.c_str(), st.build_seconds * 1e3, st.tf_update_seconds * 1e3, st.nodes,
-                    double(st.bytes) / (1 << 20));
-    }
+    print_accel(kind, *accel);
     std::printf("render time %.1f ms, %.1f samples/ray, %.1f Msamples/s (%.1f per thread)\n",
                 r.stats.seconds * 1e3, r.stats.samples_per_ray(), r.stats.msamples_per_second(),
                 r.stats.msamples_per_second() / resolve_threads(a.threads));
     std::printf("wrote %s\n", a.out.c_str());
+}
+
+// The TF animation: frames with the TF interpolated from A to B. For every structure the TF
+// change (structure update + LUT) is timed separately from the frame.
+void render_animation(const RenderArgs& a, const Setup& s) {
+    if (a.tf_animate.size() != 2)
+        throw Error("--tf-animate", "transfer functions", "expected two: A B");
+    const std::vector<AccelKind> kinds = parse_accels(a.accel);
+    const TransferFunction tf_a = resolve_transfer_function(a.tf_animate[0]);
+    const TransferFunction tf_b = resolve_transfer_function(a.tf_animate[1]);
+    const Volume vol = load_volume(a.volume);
+    const bool write_frames = kinds.size() == 1;
+    std::printf("%s: TF animation %s -> %s, %d frames at %dx%d, %d threads\n", a.volume.path.c_str(),
+                tf_a.name.c_str(), tf_b.name.c_str(), a.frames, s.w, s.h, resolve_threads(a.threads));
+    std::printf("%-10s %12s %16s %16s %14s %12s\n", "accel", "build [ms]", "TF change [ms]",
+                "TF change max", "frame [ms]", "samples/ray");
+    for (AccelKind k : kinds) {
+        auto accel = build_accel(k, vol, s.ao);
+        RayMarcher marcher(vol);
+        marcher.set_accel(accel.get());
+        const Camera cam = Camera::orbit(marcher.bounds(), s.op, s.w, s.h);
+        double tf_sum = 0, tf_max = 0, frame_sum = 0, spr_sum = 0;
+        Progress progress("animating " + to_string(k));
+        for (int f = 0; f < a.frames; ++f) {
+            const float w = float(f) / float(a.frames - 1);
+            const TransferLut lut = discretise(lerp(tf_a, tf_b, w), vol.vis_range());
+            const auto t0 = std::chrono::steady_clock::now();
+            accel->set_transfer_function(lut);
+            marcher.set_transfer_function(lut);
+            const double tf_change =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const RenderResult r = marcher.render(cam, s.ro);
+            if (write_frames) write_png(frame_path(a.out, f), r.image);
+            tf_sum += tf_change;
+            tf_max = std::max(tf_max, tf_change);
+            frame_sum += r.stats.seconds;
+            spr_sum += r.stats.samples_per_ray();
+            progress.update(double(f + 1) / a.frames);
+        }
+        progress.done();
+        std::printf("%-10s %12.1f %16.3f %16.3f %14.1f %12.1f\n", to_string(k).c_str(),
+                    accel->stats().build_seconds * 1e3, tf_sum / a.frames * 1e3, tf_max * 1e3,
+                    frame_sum / a.frames * 1e3, spr_sum / a.frames);
+    }
+    if (write_frames)
+        std::printf("wrote %s .. %s\n", frame_path(a.out, 0).c_str(),
+                    frame_path(a.out, a.frames - 1).c_str());
+}
+
+void run(RenderArgs& a) {
+    const Setup s = validate(a);
+    if (a.tf_animate.empty())
+        render_one(a, s);
+    else
+        render_animation(a, s);
 }
 
 }  // namespace
@@ -121,9 +222,16 @@ void register_render(CLI::App& app) {
     add_volume_args(*cmd, a->volume, false);
     cmd->add_flag("--demo", a->demo, "Render the default real dataset (mricron ch2better brain, mr-brain)");
     cmd->add_option("--tf", a->tf, "Transfer function: a preset name or a .json file");
+    cmd->add_option("--tf-animate", a->tf_animate,
+                    "Two TFs A B: render --frames frames interpolating from A to B and report "
+                    "the TF-change time per structure")
+        ->expected(2);
+    cmd->add_option("--frames", a->frames, "Frames of --tf-animate")->capture_default_str();
     std::string accels;
     for (const auto& n : accel_names()) accels += (accels.empty() ? "" : ", ") + n;
-    cmd->add_option("--accel", a->accel, "Empty-space skipping structure: " + accels)
+    cmd->add_option("--accel", a->accel,
+                    "Empty-space skipping structure: " + accels +
+                        " (with --tf-animate also 'all' or a comma-separated list)")
         ->capture_default_str();
     cmd->add_option("--leaf", a->leaf, "Octree leaf edge in cells (2..64, power of two)")
         ->capture_default_str();
@@ -132,7 +240,7 @@ void register_render(CLI::App& app) {
                     "Octree level traversal starts at (-1 = root)")
         ->capture_default_str();
     cmd->add_flag("--top-down", a->top_down, "Octree traversal restarts at the initial level");
-    cmd->add_option("--out,-o", a->out, "Output PNG");
+    cmd->add_option("--out,-o", a->out, "Output PNG (animation frames: NAME_000.png, ...)");
     cmd->add_option("--heatmap", a->heatmap, "Also write a per-pixel sample-count heat map PNG");
     cmd->add_option("--size", a->size, "Image width and height in pixels")->capture_default_str();
     cmd->add_option("--width", a->width, "Image width (overrides --size)");
