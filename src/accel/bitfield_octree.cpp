@@ -29,19 +29,39 @@ void BitfieldOctree::build() {
     const auto t0 = std::chrono::steady_clock::now();
     const int W = m_words;
     m_bits.assign(m_pyr.node_count() * size_t(W), 0);
-    for_each_block_cells(m_volume, m_map, 1 << m_pyr.leaf_log2, m_opts.threads, [&](const BlockCells& b) {
-        const size_t n = size_t(b.n[0]) * b.n[1] * b.n[2];
-        uint64_t acc[2] = {0, 0};
-        // Consecutive cells often share a range: remember the last one.
-        int last_lo = -1, last_hi = -1;
-        for (size_t c = 0; c < n; ++c) {
-            if (b.lo[c] == last_lo && b.hi[c] == last_hi) continue;
-            last_lo = b.lo[c], last_hi = b.hi[c];
-            const int b0 = bin(last_lo), b1 = bin(last_hi);
-            for (int w = 0; w < W; ++w) acc[w] |= range_mask(b0, b1, w);
+    // Per LUT entry its bin; per bin b the mask of bits below b (so bits [b0, b1] of a word are
+    // below[b1 + 1] ^ below[b0]), for each word.
+    std::vector<uint8_t> bin_of(static_cast<size_t>(m_lut_size));
+    for (int e = 0; e < m_lut_size; ++e) bin_of[size_t(e)] = uint8_t(bin(e));
+    uint64_t below[2][130];
+    for (int w = 0; w < 2; ++w)
+        for (int b = 0; b <= 129; ++b) below[w][b] = b <= 64 * w ? 0 : range_mask(64 * w, b - 1, w);
+    const int B = 1 << m_pyr.leaf_log2;
+    for_each_cell_row(m_volume, m_map, B, m_opts.threads, [&](const CellRow& r) {
+        uint64_t* leaf =
+            &m_bits[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2) * size_t(W)];
+        for (int i0 = 0; i0 < r.n; i0 += B, leaf += W) {
+            const int i1 = std::min(r.n, i0 + B);
+            // Common in sparse data: every cell of the chunk in one bin range [lo, hi].
+            uint16_t lo = r.lo[i0], hi = r.hi[i0];
+            for (int i = i0; i < i1; ++i) {
+                lo = std::min(lo, r.lo[i]);
+                hi = std::max(hi, r.hi[i]);
+            }
+            if (bin_of[lo] == bin_of[hi]) {
+                const int b = bin_of[lo];
+                leaf[b >> 6 < W ? b >> 6 : 0] |= uint64_t(1) << (b & 63);
+                continue;
+            }
+            for (int w = 0; w < W; ++w) {
+                uint64_t acc = leaf[w];
+                for (int i = i0; i < i1; ++i) {
+                    const int b0 = bin_of[r.lo[i]], b1 = bin_of[r.hi[i]];
+                    acc |= below[w][b1 + 1] ^ below[w][b0];
+                }
+                leaf[w] = acc;
+            }
         }
-        uint64_t* dst = &m_bits[m_pyr.index(0, b.block[0], b.block[1], b.block[2]) * size_t(W)];
-        for (int w = 0; w < W; ++w) dst[w] = acc[w];
     });
     for (int l = 1; l < m_pyr.levels; ++l)
         for (int z = 0; z < m_pyr.n[l][2]; ++z)

@@ -18,11 +18,16 @@ void BooleanOctree::set_transfer_function(const TransferLut& lut) {
     OpacityPrefix prefix;
     prefix.build(lut);
     std::fill(m_occupied.begin(), m_occupied.end(), 0);
-    for_each_block_cells(m_volume, m_map, 1 << m_pyr.leaf_log2, m_opts.threads, [&](const BlockCells& b) {
-        const size_t n = size_t(b.n[0]) * b.n[1] * b.n[2];
-        uint8_t occ = 0;
-        for (size_t c = 0; c < n && !occ; ++c) occ = prefix.visible(b.lo[c], b.hi[c]);
-        m_occupied[m_pyr.index(0, b.block[0], b.block[1], b.block[2])] = occ;
+    const int B = 1 << m_pyr.leaf_log2;
+    for_each_cell_row(m_volume, m_map, B, m_opts.threads, [&](const CellRow& r) {
+        uint8_t* leaf = &m_occupied[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2)];
+        for (int i0 = 0; i0 < r.n; i0 += B, ++leaf) {
+            if (*leaf) continue;
+            const int i1 = std::min(r.n, i0 + B);
+            uint8_t occ = 0;
+            for (int i = i0; i < i1 && !occ; ++i) occ = prefix.visible(r.lo[i], r.hi[i]);
+            *leaf = occ;
+        }
     });
     for (int l = 1; l < m_pyr.levels; ++l)
         for (int z = 0; z < m_pyr.n[l][2]; ++z)

@@ -110,7 +110,69 @@ void blocks_typed(const Volume& v, const T* data, ValueToLut map, int edge, int 
     });
 }
 
+// Pair reduction of one voxel plane: out[j][i] = op over voxels (i..i+1, j..j+1).
+template <bool Max>
+void reduce_plane(const uint16_t* in, uint16_t* out, int vx, int vy) {
+    for (int j = 0; j + 1 < vy; ++j) {
+        const uint16_t* a = in + size_t(j) * vx;
+        const uint16_t* b = a + vx;
+        uint16_t* o = out + size_t(j) * (vx - 1);
+        for (int i = 0; i + 1 < vx; ++i) {
+            const uint16_t x = Max ? std::max(a[i], a[i + 1]) : std::min(a[i], a[i + 1]);
+            const uint16_t y = Max ? std::max(b[i], b[i + 1]) : std::min(b[i], b[i + 1]);
+            o[i] = Max ? std::max(x, y) : std::min(x, y);
+        }
+    }
+}
+
+template <class T>
+void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int threads,
+                const std::function<void(const CellRow&)>& fn) {
+    const Vec3i d = v.dims();
+    const int cz = d.z - 1, cx = d.x - 1, cy = d.y - 1;
+    const int nslabs = (cz + slab - 1) / slab;
+    const VoxelLut<T> vl(map, v.vis_range());
+    const size_t plane = size_t(d.x) * size_t(d.y), cplane = size_t(cx) * size_t(cy);
+    parallel_for(size_t(nslabs), threads, [&](size_t s0, size_t s1) {
+        std::vector<uint16_t> vlo(plane), vhi(plane);
+        // Reduced planes of the current pair of voxel planes (ping-pong) and the cell layer.
+        std::vector<uint16_t> plo[2] = {std::vector<uint16_t>(cplane), std::vector<uint16_t>(cplane)};
+        std::vector<uint16_t> phi[2] = {std::vector<uint16_t>(cplane), std::vector<uint16_t>(cplane)};
+        std::vector<uint16_t> clo(static_cast<size_t>(cx)), chi(static_cast<size_t>(cx));
+        auto load = [&](int z, int slot) {
+            const T* src = data + size_t(z) * plane;
+            for (size_t i = 0; i < plane; ++i) vl.bounds(src[i], vlo[i], vhi[i]);
+            reduce_plane<false>(vlo.data(), plo[slot].data(), d.x, d.y);
+            reduce_plane<true>(vhi.data(), phi[slot].data(), d.x, d.y);
+        };
+        for (size_t sl = s0; sl < s1; ++sl) {
+            const int k0 = int(sl) * slab, k1 = std::min(cz, k0 + slab);
+            load(k0, 0);
+            for (int k = k0; k < k1; ++k) {
+                const int cur = (k - k0) & 1, nxt = cur ^ 1;
+                load(k + 1, nxt);
+                for (int j = 0; j < cy; ++j) {
+                    const uint16_t* a = plo[cur].data() + size_t(j) * cx;
+                    const uint16_t* b = plo[nxt].data() + size_t(j) * cx;
+                    const uint16_t* c = phi[cur].data() + size_t(j) * cx;
+                    const uint16_t* e = phi[nxt].data() + size_t(j) * cx;
+                    for (int i = 0; i < cx; ++i) {
+                        clo[size_t(i)] = std::min(a[i], b[i]);
+                        chi[size_t(i)] = std::max(c[i], e[i]);
+                    }
+                    fn(CellRow{j, k, cx, clo.data(), chi.data()});
+                }
+            }
+        }
+    });
+}
+
 }  // namespace
+
+void for_each_cell_row(const Volume& v, ValueToLut map, int slab, int threads,
+                       const std::function<void(const CellRow&)>& fn) {
+    visit_voxels(v, [&](const auto* data) { rows_typed(v, data, map, slab, threads, fn); });
+}
 
 void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,
                           const std::function<void(const BlockCells&)>& fn) {

@@ -30,6 +30,20 @@ struct BlockCells {
 void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,
                           const std::function<void(const BlockCells&)>& fn);
 
+// One row of cells: cells (0..n-1, j, k), their LUT-entry ranges in lo[i], hi[i].
+struct CellRow {
+    int j, k, n;
+    const uint16_t* lo;
+    const uint16_t* hi;
+};
+
+// Calls fn for every row of cells, streaming plane by plane (each voxel plane is reduced once
+// and shared by the two cell layers it bounds). Rows come in slabs of `slab` cell layers in z;
+// one slab is handled by one thread, in order of j then k, so a structure whose blocks are
+// `slab` cells deep can accumulate into them without locks. The fast path for builds.
+void for_each_cell_row(const Volume& v, ValueToLut map, int slab, int threads,
+                       const std::function<void(const CellRow&)>& fn);
+
 // Cells per axis (dims - 1) and blocks per axis for a block edge.
 inline void cell_counts(const Volume& v, int cells[3]) {
     const Vec3i d = v.dims();

@@ -68,11 +68,15 @@ void DistanceMap::set_transfer_function(const TransferLut& lut) {
     const size_t n = nx * ny * nz;
     // 1. Occupancy per block, conservative: any visible cell.
     std::vector<uint8_t> occ(n, 0);
-    for_each_block_cells(m_volume, lut.map(), m_block, m_opts.threads, [&](const BlockCells& b) {
-        const size_t cn = size_t(b.n[0]) * b.n[1] * b.n[2];
-        uint8_t o = 0;
-        for (size_t c = 0; c < cn && !o; ++c) o = prefix.visible(b.lo[c], b.hi[c]);
-        occ[(size_t(b.block[2]) * ny + b.block[1]) * nx + b.block[0]] = o;
+    for_each_cell_row(m_volume, lut.map(), m_block, m_opts.threads, [&](const CellRow& r) {
+        uint8_t* blk = &occ[(size_t(r.k / m_block) * ny + size_t(r.j / m_block)) * nx];
+        for (int i0 = 0; i0 < r.n; i0 += m_block, ++blk) {
+            if (*blk) continue;
+            const int i1 = std::min(r.n, i0 + m_block);
+            uint8_t o = 0;
+            for (int i = i0; i < i1 && !o; ++i) o = prefix.visible(r.lo[i], r.hi[i]);
+            *blk = o;
+        }
     });
     const uint16_t kFar = 0xfffe;
     if (kind() == AccelKind::Chebyshev) {

@@ -12,15 +12,19 @@ MinMaxOctree::MinMaxOctree(const Volume& v, const AccelOptions& o)
 void MinMaxOctree::build() {
     const auto t0 = std::chrono::steady_clock::now();
     m_nodes.assign(m_pyr.node_count(), Node{0xffff, 0});
-    // Leaves: union of their cells' ranges.
-    for_each_block_cells(m_volume, m_map, 1 << m_pyr.leaf_log2, m_opts.threads, [&](const BlockCells& b) {
-        const size_t n = size_t(b.n[0]) * b.n[1] * b.n[2];
-        uint16_t lo = 0xffff, hi = 0;
-        for (size_t c = 0; c < n; ++c) {
-            lo = std::min(lo, b.lo[c]);
-            hi = std::max(hi, b.hi[c]);
+    // Leaves: union of their cells' ranges, accumulated row by row.
+    const int B = 1 << m_pyr.leaf_log2;
+    for_each_cell_row(m_volume, m_map, B, m_opts.threads, [&](const CellRow& r) {
+        Node* leaf = &m_nodes[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2)];
+        for (int i0 = 0; i0 < r.n; i0 += B, ++leaf) {
+            const int i1 = std::min(r.n, i0 + B);
+            uint16_t lo = leaf->lo, hi = leaf->hi;
+            for (int i = i0; i < i1; ++i) {
+                lo = std::min(lo, r.lo[i]);
+                hi = std::max(hi, r.hi[i]);
+            }
+            *leaf = {lo, hi};
         }
-        m_nodes[m_pyr.index(0, b.block[0], b.block[1], b.block[2])] = {lo, hi};
     });
     // Inner nodes: union of their children.
     for (int l = 1; l < m_pyr.levels; ++l)
