@@ -32,8 +32,10 @@ class RegionCursor {
 public:
     static constexpr float kMargin = 0.05f;  // voxels
 
-    RegionCursor(const S& s, const CursorRay& r, float t_near, float t_far)
-        : m_s(s), m_r(r), m_t(t_near), m_far(t_far), m_seg_start(t_near) {
+    // min_skip: empty stretches shorter than this (world units) are not cut out; the renderer
+    // passes about one sample spacing, below which a cut saves no sample but splits a segment.
+    RegionCursor(const S& s, const CursorRay& r, float t_near, float t_far, float min_skip = 0.f)
+        : m_s(s), m_r(r), m_t(t_near), m_far(t_far), m_seg_start(t_near), m_min_skip(min_skip) {
         float dmax = 0;
         for (int a = 0; a < 3; ++a) dmax = std::max(dmax, std::abs(r.d[a]));
         m_margin_t = kMargin / dmax;
@@ -73,7 +75,7 @@ public:
             if (reg.empty) {
                 const float s0 = std::max(ta, m_t) + m_margin_t, s1 = tb - m_margin_t;
                 m_t = t_next;
-                if (s1 > s0) {
+                if (s1 - s0 > m_min_skip) {
                     const Segment seg{m_seg_start, s0};
                     m_seg_start = s1;
                     if (seg.t1 > seg.t0) {
@@ -96,6 +98,7 @@ private:
     const S& m_s;
     CursorRay m_r;
     float m_t, m_far, m_seg_start;
+    float m_min_skip;
     float m_margin_t, m_nudge_t;
     float m_hi[3];
     int m_last[3];

@@ -93,7 +93,7 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
                 // The structure's stretches, rounded outward to lattice samples: a few extra
                 // reference samples may be taken, a visible one is never missed.
                 typename S::Cursor cursor(accel, CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}},
-                                          t_near, t_far);
+                                          t_near, t_far, dt);
                 Segment seg;
                 bool done = false;
                 int k = 0;
