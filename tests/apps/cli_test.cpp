@@ -77,6 +77,39 @@ TEST(Cli, RendersAGeneratedVolumeAndReportsTiming) {
     EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
 }
 
+TEST(Cli, TfAnimationWritesFramesAndReportsTfChangeTime) {
+    const fs::path png = temp_dir() / "anim.png";
+    CliRun r = run("render " + small_volume().string() +
+                   " --tf-animate mr-default mr-gap --frames 3 --accel bitfield --size 24 --out " +
+                   png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("TF change"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("bitfield"), std::string::npos) << r.out;
+    for (const char* f : {"anim_000.png", "anim_001.png", "anim_002.png"})
+        EXPECT_TRUE(fs::exists(temp_dir() / f)) << f;
+    EXPECT_FALSE(fs::exists(temp_dir() / "anim_003.png"));
+    CliRun all = run("render " + small_volume().string() +
+                     " --tf-animate mr-default mr-gap --frames 2 --accel all --size 16 --out " +
+                     (temp_dir() / "all.png").string());
+    ASSERT_EQ(all.code, 0) << all.err;
+    for (const char* name : {"none", "distance", "chebyshev", "boolean", "minmax", "bitfield"})
+        EXPECT_NE(all.out.find(name), std::string::npos) << name << "\n" << all.out;
+}
+
+TEST(Cli, EveryAccelRendersTheSameBytes) {
+    std::string ref;
+    for (const char* accel : {"none", "distance", "chebyshev", "boolean", "minmax", "bitfield"}) {
+        const fs::path png = temp_dir() / (std::string("same-") + accel + ".png");
+        CliRun r = run("render " + small_volume().string() + " --tf mr-gap --size 40 --accel " +
+                       accel + " --out " + png.string());
+        ASSERT_EQ(r.code, 0) << r.err;
+        if (ref.empty())
+            ref = slurp(png);
+        else
+            EXPECT_EQ(slurp(png), ref) << accel;
+    }
+}
+
 TEST(Cli, InfoDescribesTheCh2Head) {
     CliRun r = run("info /usr/share/mricron/templates/ch2.nii.gz");
     ASSERT_EQ(r.code, 0) << r.err;
