@@ -1,5 +1,6 @@
-// Volume readers and writers: one interface, implemented in src/io/ (ITK's image IO for
-// NIfTI-1/2, NRRD, MetaImage and DICOM series; our own code for raw files).
+// Volume readers and writers: one interface, implemented in src/io/ (ITK's image IO for NRRD,
+// MetaImage headers and DICOM series; our own code for NIfTI-1/2, MetaImage voxel data and raw
+// files). Formats, conversions and error messages: docs/formats.md.
 #pragma once
 #include <functional>
 #include <optional>
@@ -33,8 +34,9 @@ Volume read_volume(const std::string& path, const ReadOptions& opts = {});
 // Parses "name_301x370x316_uint8.raw"-style names; nullopt if the name does not match.
 std::optional<RawSpec> raw_spec_from_name(const std::string& path);
 
-// Writes a volume as .nrrd, .nhdr, .nii, .nii.gz, .mha or .mhd (by extension), atomically
-// (temporary file + rename). Throws lacuna::Error on failure.
+// Writes a volume as .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd or .raw (by extension), atomically
+// (temporary file + rename). A path ending in '/' writes a DICOM series into that folder
+// (integer volumes only; not atomic). Throws lacuna::Error on failure.
 void write_volume(const std::string& path, const Volume& v);
 
 }  // namespace lacuna

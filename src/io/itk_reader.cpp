@@ -105,6 +105,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     }
     if (!readable) throw fail("header", "not a valid " + format_name(path) + " file");
 
+    if (dynamic_cast<itk::MetaImageIO*>(io.GetPointer())) check_metaimage_header(path);
     try {
         io->SetFileName(path);
         io->ReadImageInformation();

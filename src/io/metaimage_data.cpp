@@ -86,6 +86,28 @@ class Inflater {
 
 }  // namespace
 
+void check_metaimage_header(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    // Headers are a few hundred bytes; stop at the data (ElementDataFile is the last key).
+    for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
+        const size_t eq = line.find('=');
+        if (eq == std::string::npos) continue;
+        std::string key = line.substr(0, eq);
+        key.erase(key.find_last_not_of(" \t") + 1);
+        key.erase(0, key.find_first_not_of(" \t"));
+        if (to_lower(key) == "elementdatafile") return;
+        if (to_lower(key) != "ndims") continue;
+        std::string value = line.substr(eq + 1);
+        value.erase(value.find_last_not_of(" \t\r") + 1);
+        value.erase(0, value.find_first_not_of(" \t"));
+        if (value != "3" && value != "4")
+            throw Error(path, "header",
+                        "expected NDims = 3 (or 4 with a last size of 1), got '" +
+                            one_line(value, 40) + "'");
+    }
+}
+
 std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,
                                                const std::string& data_file, int header_size,
                                                bool compressed, bool binary, bool msb,

@@ -17,6 +17,11 @@ struct MetaDataLayout {
     bool swap = false;  // file byte order differs from the host's
 };
 
+// Guards MetaIO against headers it mishandles: MetaIO reads NDims-long (and NDims^2-long)
+// fields without checking NDims, so "NDims = -3" makes it try to read billions of numbers.
+// Throws Error(path, "header", ...) unless NDims is 3 or 4. Call before ITK reads the header.
+void check_metaimage_header(const std::string& path);
+
 // Locates the voxel data described by a parsed MetaImage header; nullopt for layouts left to
 // MetaIO. For uncompressed data, throws Error(header_path, "voxel data", "truncated: ...")
 // when the file is shorter than `data_bytes` — before anything is allocated.

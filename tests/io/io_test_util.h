@@ -1,5 +1,7 @@
 // Helpers for the io tests: scratch directories, file bytes, small synthetic volumes.
 #pragma once
+#include <sys/wait.h>
+#include <unistd.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -99,6 +101,38 @@ inline bool same_voxels(const Volume& a, const Volume& b) {
 }
 
 // Runs f, expects lacuna::Error, and returns its message.
+// Runs check() with the permissions of an ordinary user, so that tests of unwritable folders
+// mean something when the suite runs as root (root ignores permission bits): as root, check()
+// runs in a forked child that first drops to uid/gid 65534 ("nobody"). Returns check()'s result.
+// check() must not use gtest assertions (they would not reach the parent).
+inline bool as_unprivileged(const std::function<bool()>& check) {
+    if (::geteuid() != 0) return check();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
+        bool ok = false;
+        try {
+            ok = check();
+        } catch (...) {
+        }
+        ::_exit(ok ? 0 : 1);
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+// The message of the lacuna::Error f throws, or "" (no assertions: usable in as_unprivileged).
+inline std::string quiet_error_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.what();
+    } catch (...) {
+    }
+    return "";
+}
+
 inline std::string error_of(const std::function<void()>& f) {
     try {
         f();

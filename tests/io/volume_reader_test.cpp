@@ -17,7 +17,7 @@ bool have(const std::string& name) {
 }
 
 #define REQUIRE_TEMPLATE(name) \
-    if (!have(name)) GTEST_SKIP() << kTemplates << name << " is not installed"
+    ASSERT_TRUE(have(name)) << kTemplates << name << " is installed by scripts/install-deps"
 
 TEST(IoReader, ReadsCh2NiftiWithSpacingAndRange) {
     REQUIRE_TEMPLATE("ch2.nii.gz");
