@@ -48,5 +48,6 @@ void register_info(CLI::App& app);
 void register_render(CLI::App& app);
 void register_generate(CLI::App& app);
 void register_bench(CLI::App& app);
+void register_partition(CLI::App& app);
 
 }  // namespace lacuna::cli

@@ -10,6 +10,7 @@
 // src/accel/accel.cpp; it is then in the conformance tests and the benchmarks automatically.
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@ enum class AccelKind {
     Boolean,    // TF-dependent occupancy octree, rebuilt when the TF changes
     Distance,   // Euclidean distance map at 1/4 resolution, rebuilt when the TF changes
     Chebyshev,  // Chebyshev distance map at 1/4 resolution, rebuilt when the TF changes
+    KdTree,     // kd-tree empty-space partition (kd-tree paper), rebuilt when the TF changes
 };
 
 std::string to_string(AccelKind k);
@@ -41,6 +43,12 @@ struct AccelOptions {
     bool bidirectional = true; // octree traversal moves up and down (false: top-down only)
     int distance_block = 4;    // distance maps: cells per map voxel (the paper's 1/4 resolution)
     int threads = 0;           // build threads (0 = all)
+    int kd_max_boxes = 0;         // kd-tree: M, most subvolumes in the list (0 = every leaf)
+    int kd_delta = 0;             // kd-tree: candidate plane spacing in cells (0 = from size)
+    float kd_min_volume = 0.1f;   // kd-tree: nodes below this fraction of the grid are leaves
+    float kd_min_gain = 0.05f;    // kd-tree: a split must remove this fraction of its node
+    int kd_max_depth = 10;        // kd-tree: deepest split level (root = 0)
+    std::optional<float> kd_threshold;  // kd-tree: value threshold (`lacuna partition` only)
 };
 
 struct AccelStats {

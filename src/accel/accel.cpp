@@ -12,7 +12,8 @@ struct Entry {
 };
 constexpr Entry kAccels[] = {{AccelKind::None, "none"},         {AccelKind::Distance, "distance"},
                              {AccelKind::Chebyshev, "chebyshev"}, {AccelKind::Boolean, "boolean"},
-                             {AccelKind::MinMax, "minmax"},     {AccelKind::Bitfield, "bitfield"}};
+                             {AccelKind::MinMax, "minmax"},     {AccelKind::Bitfield, "bitfield"},
+                             {AccelKind::KdTree, "kdtree"}};
 }  // namespace
 
 std::string to_string(AccelKind k) {
@@ -49,6 +50,7 @@ std::unique_ptr<Accel> make_accel(AccelKind k, const Volume& volume, const Accel
         case AccelKind::Boolean: return std::make_unique<BooleanOctree>(volume, opts);
         case AccelKind::Distance:
         case AccelKind::Chebyshev: return std::make_unique<DistanceMap>(k, volume, opts);
+        case AccelKind::KdTree: return std::make_unique<KdTree>(volume, opts);
     }
     throw Error("--accel", "structure", "unhandled kind");
 }

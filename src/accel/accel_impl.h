@@ -5,6 +5,7 @@
 #include "accel/bitfield_octree.h"
 #include "accel/boolean_octree.h"
 #include "accel/distance_map.h"
+#include "accel/kdtree.h"
 #include "accel/minmax_octree.h"
 #include "accel/no_accel.h"
 
@@ -18,6 +19,7 @@ decltype(auto) visit_accel(const Accel& a, F&& f) {
         case AccelKind::Boolean: return f(static_cast<const BooleanOctree&>(a));
         case AccelKind::Distance:
         case AccelKind::Chebyshev: return f(static_cast<const DistanceMap&>(a));
+        case AccelKind::KdTree: return f(static_cast<const KdTree&>(a));
         case AccelKind::None: break;
     }
     return f(static_cast<const NoAccel&>(a));
