@@ -11,18 +11,23 @@ namespace lacuna {
 
 namespace {
 
-// LUT-entry bounds of one voxel value, widened by a relative 1e-6 on both sides: float
-// trilinear arithmetic (even on integer corners, once fractions enter) can land an ulp outside
-// the corner range, and the widening keeps the bounds conservative. Integer voxels: two tables
-// over every possible value.
+// LUT-entry bounds of one voxel value, widened on both sides. Float trilinear arithmetic (even on
+// integer corners, once fractions enter) can land a few ulps outside the corner range, and those
+// ulps are ulps of the *largest* corner of the cell, not of this voxel: a far-face sample
+// a + (b - a) * 1 beside a huge corner a misses a small b by ulp(a). So the widening is relative
+// to the largest magnitude in the data and the visualization range (2e-6, about 16 ulps), plus
+// 1e-6 of the value itself for volumes whose data range was never scanned. Integer voxels: two
+// tables over every possible value.
 template <class T>
 struct VoxelLut {
     static constexpr bool kTable = sizeof(T) <= 2 && std::is_integral_v<T>;
     std::vector<uint16_t> lo_table, hi_table;
     ValueToLut map;
     float widen = 0;
-    explicit VoxelLut(ValueToLut m, ValueRange vis)
-        : map(m), widen(1e-6f * (std::abs(vis.min) + std::abs(vis.max))) {
+    VoxelLut(ValueToLut m, ValueRange vis, ValueRange data)
+        : map(m),
+          widen(2e-6f * std::max({std::abs(vis.min), std::abs(vis.max), std::abs(data.min),
+                                  std::abs(data.max)})) {
         if constexpr (kTable) {
             const int lo = std::numeric_limits<T>::min(), hi = std::numeric_limits<T>::max();
             lo_table.resize(size_t(hi - lo + 1));
@@ -58,7 +63,7 @@ void blocks_typed(const Volume& v, const T* data, ValueToLut map, int edge, int 
     cell_counts(v, cells);
     int nb[3];
     for (int a = 0; a < 3; ++a) nb[a] = (cells[a] + edge - 1) / edge;
-    const VoxelLut<T> vl(map, v.vis_range());
+    const VoxelLut<T> vl(map, v.vis_range(), v.data_range());
     const Vec3i d = v.dims();
     const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
     parallel_for(size_t(nb[2]) * size_t(nb[1]), threads, [&](size_t b0, size_t b1) {
@@ -131,7 +136,7 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
     const Vec3i d = v.dims();
     const int cz = d.z - 1, cx = d.x - 1, cy = d.y - 1;
     const int nslabs = (cz + slab - 1) / slab;
-    const VoxelLut<T> vl(map, v.vis_range());
+    const VoxelLut<T> vl(map, v.vis_range(), v.data_range());
     const size_t plane = size_t(d.x) * size_t(d.y), cplane = size_t(cx) * size_t(cy);
     parallel_for(size_t(nslabs), threads, [&](size_t s0, size_t s1) {
         std::vector<uint16_t> vlo(plane), vhi(plane);

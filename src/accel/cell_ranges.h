@@ -3,8 +3,9 @@
 //
 // A trilinear sample in cell (i,j,k) lies between the min and max of the cell's 8 corner voxels
 // (i..i+1, j..j+1, k..k+1), and ValueToLut is monotone, so it reads a LUT entry in
-// [map(min corner), map(max corner)]. Float32 grids are widened by a relative 1e-6 before
-// mapping: float trilinear arithmetic can exceed its corners by an ulp.
+// [map(min corner), map(max corner)]. Corner values are widened before mapping (relative to the
+// largest magnitude of the data and visualization ranges): float trilinear arithmetic can
+// exceed its corners by a few ulps of the cell's largest corner.
 #pragma once
 #include <cstdint>
 #include <functional>

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <random>
 
+#include "common/rng.h"
 #include "lacuna/accel.h"
 #include "lacuna/io.h"
 #include "lacuna/renderer.h"
@@ -21,18 +22,7 @@
 namespace lacuna {
 namespace {
 
-// Deterministic generator for the randomized cases (std distributions are not portable).
-struct Rng {
-    uint64_t s;
-    uint64_t next() {
-        uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    float uniform() { return float(next() >> 40) / float(1 << 24); }
-    int range(int lo, int hi) { return lo + int(next() % uint64_t(hi - lo + 1)); }
-};
+using test::Rng;
 
 struct Case {
     std::string name;
