@@ -52,6 +52,27 @@ struct IndexRay {
     float ox, oy, oz, dx, dy, dz;
 };
 
+// Slab test of a ray against the index-space box [0, hi]. Returns false on a miss. Every
+// consumer that must reproduce the reference's lattice (the marcher, the sample analysis) calls
+// this one function, so t_near and t_far agree to the bit.
+inline bool intersect_box(const IndexRay& r, const float hi[3], float& t0, float& t1) {
+    t0 = 0.f;
+    t1 = INFINITY;
+    const float o[3] = {r.ox, r.oy, r.oz}, d[3] = {r.dx, r.dy, r.dz};
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.f) {
+            if (o[a] < 0.f || o[a] > hi[a]) return false;
+            continue;
+        }
+        const float inv = 1.f / d[a];
+        float ta = (0.f - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    return t0 < t1;
+}
+
 // Marches samples k in [k0, k1) of the lattice t_k = t_base + (k + 0.5)*dt. Returns the number
 // of samples taken; stops early (setting `done`) once opacity reaches `ert`.
 //

@@ -39,25 +39,6 @@ Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; 
 
 namespace {
 
-// Slab test of a ray against the index-space box [0, hi]. Returns false on a miss.
-bool intersect_box(const kernel::IndexRay& r, Vec3f hi, float& t0, float& t1) {
-    t0 = 0.f;
-    t1 = INFINITY;
-    const float o[3] = {r.ox, r.oy, r.oz}, d[3] = {r.dx, r.dy, r.dz};
-    for (int a = 0; a < 3; ++a) {
-        if (d[a] == 0.f) {
-            if (o[a] < 0.f || o[a] > hi[a]) return false;
-            continue;
-        }
-        const float inv = 1.f / d[a];
-        float ta = (0.f - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-    }
-    return t0 < t1;
-}
-
 template <class T, class Index, class S>
 void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
                  const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
@@ -76,7 +57,7 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
                        float(1.0 / vol.spacing.z)};
     const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
     const float dt = opt.step * min_sp;
-    const Vec3f hi{g.hi_x, g.hi_y, g.hi_z};
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     uint64_t tile_samples = 0, tile_rays = 0;
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
@@ -86,7 +67,7 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
             kernel::Accum acc;
             uint32_t n = 0;
             float t_near, t_far;
-            if (intersect_box(r, hi, t_near, t_far)) {
+            if (kernel::intersect_box(r, hi, t_near, t_far)) {
                 ++tile_rays;
                 // Number of lattice samples with t_k < t_far.
                 const int k_end = std::max(int(std::ceil((t_far - t_near) / dt - 0.5f)), 0);

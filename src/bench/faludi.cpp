@@ -1,0 +1,351 @@
+#include "bench/faludi.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "lacuna/error.h"
+#include "lacuna/renderer.h"
+#include "render/sample_analysis.h"
+
+namespace lacuna::bench {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string fmt(const char* f, double a) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, a);
+    return buf;
+}
+
+RenderOptions render_options(const FaludiOptions& o, RowMode m) {
+    RenderOptions ro;
+    ro.step = o.step;
+    ro.ert = m == RowMode::EarlyExit ? o.ert : 2.f;
+    ro.threads = o.threads;
+    return ro;
+}
+
+// Builds a structure and times its TF changes.
+StructureResult build_structure(AccelKind k, const BenchDataset& d, const FaludiOptions& o,
+                                std::unique_ptr<Accel>& accel) {
+    StructureResult s;
+    s.kind = k;
+    AccelOptions ao = o.accel;
+    ao.threads = o.threads;
+    const auto t0 = std::chrono::steady_clock::now();
+    accel = make_accel(k, *d.volume, ao);
+    accel->set_transfer_function(d.lut);
+    s.generation_ms = ms_since(t0);
+    s.build_ms = accel->stats().build_seconds * 1e3;
+    // Every structure in lacuna recomputes its whole TF-dependent part on each change (none
+    // caches the previous LUT), so setting the same LUT again costs a real change.
+    std::vector<double> tf;
+    tf.push_back(accel->stats().tf_update_seconds * 1e3);
+    for (int r = 1; r < std::max(1, o.tf_repeats); ++r) {
+        accel->set_transfer_function(d.lut);
+        tf.push_back(accel->stats().tf_update_seconds * 1e3);
+    }
+    s.tf_change_ms = percentile(tf, 50);
+    s.bytes = accel->stats().bytes;
+    s.nodes = accel->stats().nodes;
+    return s;
+}
+
+// One cell of the table; compares view 0 with `reference` (none's), or hands view 0 back in
+// `first` (for none itself).
+CellResult run_cell(AccelKind k, const RayMarcher& m, const std::vector<Camera>& cams,
+                    const RenderOptions& ro, const Image* reference, Image* first = nullptr) {
+    OrbitRun run = run_orbit(m, cams, ro);
+    if (first) *first = std::move(run.first_image);
+    CellResult c;
+    c.kind = k;
+    std::vector<double> ms;
+    for (double s : run.frame_seconds) ms.push_back(s * 1e3);
+    c.frame_ms = summarize(ms);
+    c.samples = run.samples;
+    c.rays = run.rays;
+    c.exact = !reference || run.first_image.rgba == reference->rgba;
+    return c;
+}
+
+void log_cell(const LogFn& log, const DatasetResult& d, const RowResult& row, const CellResult& c) {
+    if (!log) return;
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "  %-16s %-14s %-10s mean %9.2f ms  p99 %9.2f ms  %7.1f samples/ray  %6.2fx",
+                  d.name.c_str(), to_string(row.mode).c_str(), to_string(c.kind).c_str(),
+                  c.frame_ms.mean, c.frame_ms.p99, c.samples_per_ray(), c.speedup);
+    std::string s = line;
+    if (row.ideal_samples && c.kind != AccelKind::None)
+        s += " (" + fmt("%.0f", 100 * row.share_of_ideal(c.kind)) + "% of ideal)";
+    log(s + "  exact " + (c.exact ? "yes" : "NO"));
+}
+
+DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const LogFn& log) {
+    DatasetResult out;
+    out.name = d.name;
+    out.description = d.description;
+    out.tf_name = d.tf_name;
+    out.dims = d.volume->dims();
+    out.type = d.volume->type();
+    out.spacing = d.volume->spacing;
+
+    RayMarcher m(*d.volume);
+    m.set_transfer_function(d.lut);
+    const std::vector<Camera> cams = orbit_cameras(m.bounds(), o.orbit);
+    const std::vector<AccelKind> kinds = bench_columns(o.accels);
+
+    // 1. The reference rows (none) and their view-0 images.
+    std::vector<Image> reference;
+    for (RowMode mode : o.modes) {
+        RowResult row;
+        row.mode = mode;
+        row.ert = render_options(o, mode).ert;
+        out.rows.push_back(row);
+    }
+    out.structures.push_back(StructureResult{});
+    for (RowResult& row : out.rows) {
+        if (log) log("  " + d.name + " " + to_string(row.mode) + " none ...");
+        reference.push_back(Image{});
+        CellResult c = run_cell(AccelKind::None, m, cams, render_options(o, row.mode), nullptr,
+                                &reference.back());
+        c.exact = true;
+        c.speedup = c.sample_reduction = 1;
+        row.cells.push_back(c);
+    }
+
+    // 2. The ideal: visible-cell samples over the same orbit.
+    {
+        const auto t0 = std::chrono::steady_clock::now();
+        const VisibleCells cells(*d.volume, d.lut, o.threads);
+        out.visible_cell_fraction = cells.visible_fraction();
+        if (o.ideal) {
+            for (RowResult& row : out.rows) {
+                const auto t1 = std::chrono::steady_clock::now();
+                const RenderOptions ro = render_options(o, row.mode);
+                for (const Camera& cam : cams)
+                    row.ideal_samples +=
+                        count_visible_cell_samples(*d.volume, d.lut, cells, cam, ro);
+                row.ideal_seconds = ms_since(t1) * 1e-3;
+            }
+        }
+        if (log) {
+            std::string line = "  " + d.name + ": " + fmt("%.2f", 100 * out.visible_cell_fraction) +
+                               "% of cells visible";
+            for (const RowResult& row : out.rows)
+                if (row.ideal_samples)
+                    line += "; " + to_string(row.mode) + " ideal speedup " +
+                            fmt("%.2f", row.ideal_speedup()) + "x";
+            log(line + " (" + fmt("%.1f", ms_since(t0)) + " ms)");
+        }
+    }
+    for (RowResult& row : out.rows) log_cell(log, out, row, row.cells[0]);
+
+    // 3. Every structure: build, time TF changes, render each row, compare view 0.
+    for (AccelKind k : kinds) {
+        if (k == AccelKind::None) continue;
+        std::unique_ptr<Accel> accel;
+        const StructureResult s = build_structure(k, d, o, accel);
+        out.structures.push_back(s);
+        if (log) {
+            char line[256];
+            std::snprintf(
+                line, sizeof line,
+                "  %-16s %-10s generation %.1f ms, TF change %.4f ms, %.2f MiB, %zu nodes",
+                d.name.c_str(), to_string(k).c_str(), s.generation_ms, s.tf_change_ms,
+                double(s.bytes) / (1 << 20), s.nodes);
+            log(line);
+        }
+        m.set_accel(accel.get());
+        for (size_t r = 0; r < out.rows.size(); ++r) {
+            RowResult& row = out.rows[r];
+            CellResult c = run_cell(k, m, cams, render_options(o, row.mode), &reference[r]);
+            const CellResult& none = row.cells[0];
+            c.speedup = c.frame_ms.mean > 0 ? none.frame_ms.mean / c.frame_ms.mean : 0;
+            c.sample_reduction = c.samples ? double(none.samples) / double(c.samples) : 0;
+            row.cells.push_back(c);
+            log_cell(log, out, row, c);
+            if (!c.exact && log)
+                log("  !!! " + d.name + " " + to_string(row.mode) + " " + to_string(k) +
+                    ": view 0 differs from none: an exactness bug");
+        }
+        m.set_accel(nullptr);
+    }
+    return out;
+}
+
+}  // namespace
+
+std::string to_string(RowMode m) {
+    return m == RowMode::MarchingOnly ? "Marching only" : "+ Early exit";
+}
+
+std::string to_string(TargetStatus s) {
+    switch (s) {
+        case TargetStatus::Met:
+            return "met";
+        case TargetStatus::Missed:
+            return "MISSED";
+        case TargetStatus::NotMeasured:
+            return "not measured";
+        case TargetStatus::Info:
+            return "info";
+    }
+    return "?";
+}
+
+const CellResult* RowResult::find(AccelKind k) const {
+    for (const CellResult& c : cells)
+        if (c.kind == k) return &c;
+    return nullptr;
+}
+
+double RowResult::ideal_speedup() const {
+    const CellResult* none = find(AccelKind::None);
+    if (!none || ideal_samples == 0) return 0;
+    return double(none->samples) / double(ideal_samples);
+}
+
+double RowResult::share_of_ideal(AccelKind k) const {
+    const CellResult* c = find(k);
+    const double ideal = ideal_speedup();
+    return c && ideal > 0 ? c->speedup / ideal : 0;
+}
+
+const StructureResult* DatasetResult::find(AccelKind k) const {
+    for (const StructureResult& s : structures)
+        if (s.kind == k) return &s;
+    return nullptr;
+}
+
+std::vector<std::string> FaludiReport::exactness_failures() const {
+    std::vector<std::string> out;
+    for (const DatasetResult& d : datasets)
+        for (const RowResult& r : d.rows)
+            for (const CellResult& c : r.cells)
+                if (!c.exact)
+                    out.push_back(d.name + " / " + to_string(r.mode) + " / " + to_string(c.kind));
+    return out;
+}
+
+std::vector<AccelKind> bench_columns(const std::vector<AccelKind>& accels) {
+    std::vector<AccelKind> out{AccelKind::None};
+    for (AccelKind k : accels)
+        if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+    return out;
+}
+
+FaludiReport run_faludi(const std::vector<BenchDataset>& datasets, const FaludiOptions& options,
+                        const LogFn& log, const PartialFn& partial) {
+    if (options.modes.empty())
+        throw Error("bench faludi", "rows", "expected at least one row mode");
+    FaludiReport report;
+    report.options = options;
+    for (const BenchDataset& d : datasets) {
+        if (log) log("dataset " + d.name + ": " + d.description);
+        report.datasets.push_back(run_dataset(d, options, log));
+        if (partial) partial(report);
+    }
+    return report;
+}
+
+// ---- targets ----------------------------------------------------------------------------------
+
+namespace {
+
+bool is_large(const DatasetResult& d) {
+    return d.dims.x >= 512 && d.dims.y >= 512 && d.dims.z >= 512;
+}
+
+std::string row_label(const DatasetResult& d, const RowResult& r) {
+    return d.name + " " + (r.mode == RowMode::MarchingOnly ? "marching" : "early-exit");
+}
+
+// Worst row of f (lower is worse when `higher_is_better`), over the rows where f is defined.
+struct Worst {
+    bool any = false;
+    double value = 0;
+    std::string where;
+    void add(double v, const std::string& w, bool higher_is_better) {
+        if (!any || (higher_is_better ? v < value : v > value)) value = v, where = w;
+        any = true;
+    }
+};
+
+TargetCheck verdict(std::string target, const Worst& w, double threshold, bool higher_is_better,
+                    const char* unit, const std::string& extra = {}) {
+    TargetCheck t;
+    t.target = std::move(target);
+    if (!w.any) {
+        t.status = TargetStatus::NotMeasured;
+        t.measured = "no row to measure" + extra;
+        return t;
+    }
+    const bool ok = higher_is_better ? w.value >= threshold : w.value <= threshold;
+    t.status = ok ? TargetStatus::Met : TargetStatus::Missed;
+    t.measured = "worst " + fmt(unit, w.value) + " (" + w.where + ")" + extra;
+    return t;
+}
+
+}  // namespace
+
+std::vector<TargetCheck> check_targets(const FaludiReport& rep) {
+    std::vector<TargetCheck> out;
+    Worst share, tree, vs_distance, vs_minmax, gen, tf;
+    double ratio_lo = 1e300, ratio_hi = 0;
+    for (const DatasetResult& d : rep.datasets) {
+        for (const RowResult& r : d.rows) {
+            const CellResult* bf = r.find(AccelKind::Bitfield);
+            if (!bf) continue;
+            if (r.ideal_speedup() > 0)
+                share.add(100 * r.share_of_ideal(AccelKind::Bitfield), row_label(d, r), true);
+            if (is_large(d)) tree.add(bf->speedup, row_label(d, r), true);
+            double best_distance = 0;
+            for (AccelKind k : {AccelKind::Distance, AccelKind::Chebyshev})
+                if (const CellResult* c = r.find(k))
+                    if (best_distance == 0 || c->frame_ms.mean < best_distance)
+                        best_distance = c->frame_ms.mean;
+            if (best_distance > 0)
+                vs_distance.add(bf->frame_ms.mean / best_distance, row_label(d, r), false);
+            if (d.tf_name == "mr-gap")
+                if (const CellResult* mm = r.find(AccelKind::MinMax))
+                    vs_minmax.add(mm->frame_ms.mean / bf->frame_ms.mean, row_label(d, r), true);
+        }
+        if (const StructureResult* b = d.find(AccelKind::Bitfield)) {
+            if (is_large(d) && d.type == VoxelType::UInt8) gen.add(b->generation_ms, d.name, false);
+            tf.add(b->tf_change_ms, d.name, false);
+            for (AccelKind k : {AccelKind::Distance, AccelKind::Chebyshev})
+                if (const StructureResult* s = d.find(k); s && b->tf_change_ms > 0) {
+                    ratio_lo = std::min(ratio_lo, s->tf_change_ms / b->tf_change_ms);
+                    ratio_hi = std::max(ratio_hi, s->tf_change_ms / b->tf_change_ms);
+                }
+        }
+    }
+    out.push_back(verdict("bitfield reaches >= 70% of the ideal speedup on every row", share, 70,
+                          true, "%.0f%%"));
+    out.push_back(verdict("bitfield >= 5x over none on the >= 512^3 sparse tree-like volume", tree,
+                          5, true, "%.2fx"));
+    out.push_back(verdict("bitfield frame time within 1.3x of the faster distance map on every row",
+                          vs_distance, 1.3, false, "%.2fx"));
+    out.push_back(verdict("bitfield >= 1.5x faster than minmax on the mr-gap rows", vs_minmax, 1.5,
+                          true, "%.2fx"));
+    out.push_back(verdict("bitfield octree generation for a 512^3 uint8 volume <= 150 ms", gen, 150,
+                          false, "%.1f ms"));
+    out.push_back(verdict("bitfield TF change <= 0.1 ms", tf, 0.1, false, "%.4f ms"));
+    TargetCheck ratio;
+    ratio.target =
+        "distance maps' rebuild time on a TF change, as a multiple of bitfield's TF change";
+    ratio.status = ratio_hi > 0 ? TargetStatus::Info : TargetStatus::NotMeasured;
+    ratio.measured = ratio_hi > 0 ? fmt("%.0f", ratio_lo) + "x .. " + fmt("%.0f", ratio_hi) + "x"
+                                  : "no distance map and bitfield pair";
+    out.push_back(ratio);
+    return out;
+}
+
+}  // namespace lacuna::bench
