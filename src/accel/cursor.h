@@ -34,8 +34,20 @@ public:
 
     // min_skip: empty stretches shorter than this (world units) are not cut out; the renderer
     // passes about one sample spacing, below which a cut saves no sample but splits a segment.
-    RegionCursor(const S& s, const CursorRay& r, float t_near, float t_far, float min_skip = 0.f)
-        : m_s(s), m_r(r), m_t(t_near), m_far(t_far), m_seg_start(t_near), m_min_skip(min_skip) {
+    //
+    // chunk: an occupied stretch is handed out once it is this long (world units; 0 = only at
+    // the next empty region or the ray's end). The marcher may stop early (early ray
+    // termination), and walking the structure far beyond where it stops costs region queries
+    // for nothing: through a head, every leaf up to the far side.
+    RegionCursor(const S& s, const CursorRay& r, float t_near, float t_far, float min_skip = 0.f,
+                 float chunk = 0.f)
+        : m_s(s),
+          m_r(r),
+          m_t(t_near),
+          m_far(t_far),
+          m_seg_start(t_near),
+          m_min_skip(min_skip),
+          m_chunk(chunk > 0.f ? chunk : INFINITY) {
         float dmax = 0;
         for (int a = 0; a < 3; ++a) dmax = std::max(dmax, std::abs(r.d[a]));
         m_margin_t = kMargin / dmax;
@@ -44,6 +56,7 @@ public:
         for (int a = 0; a < 3; ++a) {
             m_hi[a] = float(n[a]);
             m_last[a] = n[a] - 1;
+            m_inv[a] = r.d[a] == 0.f ? 0.f : 1.f / r.d[a];
         }
     }
 
@@ -63,9 +76,8 @@ public:
             float ta = -INFINITY, tb = INFINITY;
             for (int a = 0; a < 3; ++a) {
                 if (m_r.d[a] == 0.f) continue;
-                const float inv = 1.f / m_r.d[a];
-                float t0 = (float(reg.box.lo[a]) - m_r.o[a]) * inv;
-                float t1 = (float(reg.box.hi[a]) - m_r.o[a]) * inv;
+                float t0 = (float(reg.box.lo[a]) - m_r.o[a]) * m_inv[a];
+                float t1 = (float(reg.box.hi[a]) - m_r.o[a]) * m_inv[a];
                 if (t0 > t1) std::swap(t0, t1);
                 ta = std::max(ta, t0);
                 tb = std::min(tb, t1);
@@ -85,8 +97,13 @@ public:
                 }
                 continue;
             }
-            // 4. Occupied: march on through it.
+            // 4. Occupied: march on through it; hand out a long enough stretch now.
             m_t = t_next;
+            if (m_t - m_seg_start >= m_chunk && m_t < m_far) {
+                out = {m_seg_start, m_t};
+                m_seg_start = m_t;
+                return true;
+            }
         }
         if (m_done) return false;
         m_done = true;
@@ -98,9 +115,9 @@ private:
     const S& m_s;
     CursorRay m_r;
     float m_t, m_far, m_seg_start;
-    float m_min_skip;
+    float m_min_skip, m_chunk;
     float m_margin_t, m_nudge_t;
-    float m_hi[3];
+    float m_hi[3], m_inv[3];
     int m_last[3];
     int m_hint = -1;
     bool m_done = false;

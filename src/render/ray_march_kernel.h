@@ -89,6 +89,25 @@ inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, 
     uint32_t n = 0;
     for (int kb = k0; kb < k1; kb += kBatch) {
         const int m = k1 - kb < kBatch ? k1 - kb : kBatch;
+        if (m < kBatch) {
+            // A short tail (segments end anywhere): one sample at a time, same arithmetic.
+            for (int l = 0; l < m; ++l) {
+                const float t = t_base + (float(kb + l) + 0.5f) * dt;
+                const Rgba& c =
+                    lut[map(trilinear(g, r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz))];
+                ++n;
+                const float w = 1.f - acc.a;
+                acc.r += w * c.r;
+                acc.g += w * c.g;
+                acc.b += w * c.b;
+                acc.a += w * c.a;
+                if (acc.a >= ert) {
+                    done = true;
+                    return n;
+                }
+            }
+            return n;
+        }
         float fx[kBatch], fy[kBatch], fz[kBatch];
         Index off[kBatch];
         // 1. Lattice positions, clamped into the box; cell index and fractions.

@@ -39,6 +39,10 @@ Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; 
 
 namespace {
 
+// With early ray termination the cursor hands out occupied stretches of at most about this many
+// samples, so a ray that turns opaque early does not walk the structure to its far end.
+constexpr float kChunk = 16.f;
+
 template <class T, class Index, class S>
 void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
                  const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
@@ -74,7 +78,7 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
                 // The structure's stretches, rounded outward to lattice samples: a few extra
                 // reference samples may be taken, a visible one is never missed.
                 typename S::Cursor cursor(accel, CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}},
-                                          t_near, t_far, dt);
+                                          t_near, t_far, dt, opt.ert < 1.f ? kChunk * dt : 0.f);
                 Segment seg;
                 bool done = false;
                 int k = 0;
