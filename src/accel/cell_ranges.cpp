@@ -45,6 +45,9 @@ struct VoxelLut {
         lo = uint16_t(map(x - w));
         hi = uint16_t(map(x + w));
     }
+    // Integer voxels only: the table bounds of one value.
+    uint16_t lower(T x) const { return lo_table[size_t(int(x) - int(std::numeric_limits<T>::min()))]; }
+    uint16_t upper(T x) const { return hi_table[size_t(int(x) - int(std::numeric_limits<T>::min()))]; }
     void bounds(T x, uint16_t& lo, uint16_t& hi) const {
         if constexpr (kTable) {
             const size_t e = size_t(int(x) - int(std::numeric_limits<T>::min()));
@@ -116,20 +119,25 @@ void blocks_typed(const Volume& v, const T* data, ValueToLut map, int edge, int 
 }
 
 // Pair reduction of one voxel plane: out[j][i] = op over voxels (i..i+1, j..j+1).
-template <bool Max>
-void reduce_plane(const uint16_t* in, uint16_t* out, int vx, int vy) {
+template <bool Max, class V>
+void reduce_plane(const V* in, V* out, int vx, int vy) {
     for (int j = 0; j + 1 < vy; ++j) {
-        const uint16_t* a = in + size_t(j) * vx;
-        const uint16_t* b = a + vx;
-        uint16_t* o = out + size_t(j) * (vx - 1);
+        const V* a = in + size_t(j) * vx;
+        const V* b = a + vx;
+        V* o = out + size_t(j) * (vx - 1);
         for (int i = 0; i + 1 < vx; ++i) {
-            const uint16_t x = Max ? std::max(a[i], a[i + 1]) : std::min(a[i], a[i + 1]);
-            const uint16_t y = Max ? std::max(b[i], b[i + 1]) : std::min(b[i], b[i + 1]);
+            const V x = Max ? std::max(a[i], a[i + 1]) : std::min(a[i], a[i + 1]);
+            const V y = Max ? std::max(b[i], b[i + 1]) : std::min(b[i], b[i + 1]);
             o[i] = Max ? std::max(x, y) : std::min(x, y);
         }
     }
 }
 
+// Streams cells row by row; every voxel plane is reduced once (2x2 pairs in the plane, then
+// pairs of planes). Integer voxels: the reduction runs on the raw values and only each cell's
+// min and max corner are mapped to LUT entries (the voxel bounds are monotone in the value, so
+// the lowest lower bound is that of the smallest corner: same answer, half the memory traffic
+// and a quarter of the table lookups). Float voxels map every voxel first (NaN-free order).
 template <class T>
 void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int threads,
                 const std::function<void(const CellRow&)>& fn) {
@@ -137,18 +145,25 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
     const int cz = d.z - 1, cx = d.x - 1, cy = d.y - 1;
     const int nslabs = (cz + slab - 1) / slab;
     const VoxelLut<T> vl(map, v.vis_range(), v.data_range());
+    constexpr bool kRaw = VoxelLut<T>::kTable;
+    using V = std::conditional_t<kRaw, T, uint16_t>;  // type of the reduced planes
     const size_t plane = size_t(d.x) * size_t(d.y), cplane = size_t(cx) * size_t(cy);
     parallel_for(size_t(nslabs), threads, [&](size_t s0, size_t s1) {
-        std::vector<uint16_t> vlo(plane), vhi(plane);
+        std::vector<uint16_t> vlo(kRaw ? 0 : plane), vhi(kRaw ? 0 : plane);
         // Reduced planes of the current pair of voxel planes (ping-pong) and the cell layer.
-        std::vector<uint16_t> plo[2] = {std::vector<uint16_t>(cplane), std::vector<uint16_t>(cplane)};
-        std::vector<uint16_t> phi[2] = {std::vector<uint16_t>(cplane), std::vector<uint16_t>(cplane)};
+        std::vector<V> plo[2] = {std::vector<V>(cplane), std::vector<V>(cplane)};
+        std::vector<V> phi[2] = {std::vector<V>(cplane), std::vector<V>(cplane)};
         std::vector<uint16_t> clo(static_cast<size_t>(cx)), chi(static_cast<size_t>(cx));
         auto load = [&](int z, int slot) {
             const T* src = data + size_t(z) * plane;
-            for (size_t i = 0; i < plane; ++i) vl.bounds(src[i], vlo[i], vhi[i]);
-            reduce_plane<false>(vlo.data(), plo[slot].data(), d.x, d.y);
-            reduce_plane<true>(vhi.data(), phi[slot].data(), d.x, d.y);
+            if constexpr (kRaw) {
+                reduce_plane<false>(src, plo[slot].data(), d.x, d.y);
+                reduce_plane<true>(src, phi[slot].data(), d.x, d.y);
+            } else {
+                for (size_t i = 0; i < plane; ++i) vl.bounds(src[i], vlo[i], vhi[i]);
+                reduce_plane<false>(vlo.data(), plo[slot].data(), d.x, d.y);
+                reduce_plane<true>(vhi.data(), phi[slot].data(), d.x, d.y);
+            }
         };
         for (size_t sl = s0; sl < s1; ++sl) {
             const int k0 = int(sl) * slab, k1 = std::min(cz, k0 + slab);
@@ -157,13 +172,20 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
                 const int cur = (k - k0) & 1, nxt = cur ^ 1;
                 load(k + 1, nxt);
                 for (int j = 0; j < cy; ++j) {
-                    const uint16_t* a = plo[cur].data() + size_t(j) * cx;
-                    const uint16_t* b = plo[nxt].data() + size_t(j) * cx;
-                    const uint16_t* c = phi[cur].data() + size_t(j) * cx;
-                    const uint16_t* e = phi[nxt].data() + size_t(j) * cx;
-                    for (int i = 0; i < cx; ++i) {
-                        clo[size_t(i)] = std::min(a[i], b[i]);
-                        chi[size_t(i)] = std::max(c[i], e[i]);
+                    const V* a = plo[cur].data() + size_t(j) * cx;
+                    const V* b = plo[nxt].data() + size_t(j) * cx;
+                    const V* c = phi[cur].data() + size_t(j) * cx;
+                    const V* e = phi[nxt].data() + size_t(j) * cx;
+                    if constexpr (kRaw) {
+                        for (int i = 0; i < cx; ++i) {
+                            clo[size_t(i)] = vl.lower(std::min(a[i], b[i]));
+                            chi[size_t(i)] = vl.upper(std::max(c[i], e[i]));
+                        }
+                    } else {
+                        for (int i = 0; i < cx; ++i) {
+                            clo[size_t(i)] = std::min(a[i], b[i]);
+                            chi[size_t(i)] = std::max(c[i], e[i]);
+                        }
                     }
                     fn(CellRow{j, k, cx, clo.data(), chi.data()});
                 }
