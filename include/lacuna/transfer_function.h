@@ -76,6 +76,10 @@ public:
         return int(u);
     }
     int size() const { return m_last + 1; }
+    // The affine map's terms, for kernels that evaluate operator() several lanes at a time.
+    float offset() const { return m_min; }
+    float scale() const { return m_scale; }
+    int last() const { return m_last; }
 
 private:
     float m_min = 0, m_scale = 1;

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "lacuna/transfer_function.h"
+#include "core/simd.h"
 
 namespace lacuna::kernel {
 
@@ -77,7 +79,8 @@ inline bool intersect_box(const IndexRay& r, const float hi[3], float& t0, float
 // of samples taken; stops early (setting `done`) once opacity reaches `ert`.
 //
 // Samples are computed in batches of kBatch: positions, corner loads, interpolation and LUT
-// indices in straight-line loops the compiler vectorises, then a serial compositing loop. The
+// indices (SSE4.1 in core/simd.h for int32 offsets, plain loops otherwise), then a serial
+// compositing loop. The
 // arithmetic per sample is exactly that of trilinear() above (same operations, same order, no
 // fma contraction), so a batch gives the same bits as one sample at a time; samples of a batch
 // past an early termination are computed but never composited or counted.
@@ -111,20 +114,34 @@ inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, 
         float fx[kBatch], fy[kBatch], fz[kBatch];
         Index off[kBatch];
         // 1. Lattice positions, clamped into the box; cell index and fractions.
-        for (int l = 0; l < kBatch; ++l) {
-            const float t = t_base + (float(kb + l) + 0.5f) * dt;
-            float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
-            x = x < 0.f ? 0.f : (x > g.hi_x ? g.hi_x : x);
-            y = y < 0.f ? 0.f : (y > g.hi_y ? g.hi_y : y);
-            z = z < 0.f ? 0.f : (z > g.hi_z ? g.hi_z : z);
-            int i = int(x), j = int(y), k = int(z);
-            i = i < g.cell_x ? i : g.cell_x;
-            j = j < g.cell_y ? j : g.cell_y;
-            k = k < g.cell_z ? k : g.cell_z;
-            fx[l] = x - float(i);
-            fy[l] = y - float(j);
-            fz[l] = z - float(k);
-            off[l] = Index(k) * Index(g.sz) + Index(j) * Index(g.sy) + Index(i);
+#if LACUNA_SIMD_SSE41
+        constexpr bool kSimd = std::is_same_v<Index, int32_t> && kBatch == 8;
+#else
+        constexpr bool kSimd = false;
+#endif
+#if LACUNA_SIMD_SSE41
+        if constexpr (kSimd) {
+            simd::positions8(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, t_base, dt, kb, g.hi_x, g.hi_y,
+                             g.hi_z, g.cell_x, g.cell_y, g.cell_z, int32_t(g.sy), int32_t(g.sz),
+                             fx, fy, fz, off);
+        } else
+#endif
+        {
+            for (int l = 0; l < kBatch; ++l) {
+                const float t = t_base + (float(kb + l) + 0.5f) * dt;
+                float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
+                x = x < 0.f ? 0.f : (x > g.hi_x ? g.hi_x : x);
+                y = y < 0.f ? 0.f : (y > g.hi_y ? g.hi_y : y);
+                z = z < 0.f ? 0.f : (z > g.hi_z ? g.hi_z : z);
+                int i = int(x), j = int(y), k = int(z);
+                i = i < g.cell_x ? i : g.cell_x;
+                j = j < g.cell_y ? j : g.cell_y;
+                k = k < g.cell_z ? k : g.cell_z;
+                fx[l] = x - float(i);
+                fy[l] = y - float(j);
+                fz[l] = z - float(k);
+                off[l] = Index(k) * Index(g.sz) + Index(j) * Index(g.sy) + Index(i);
+            }
         }
         // 2. The 8 corners of each sample's cell.
         float c000[kBatch], c100[kBatch], c010[kBatch], c110[kBatch], c001[kBatch], c101[kBatch],
@@ -142,13 +159,21 @@ inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, 
         }
         // 3. Trilinear interpolation and the LUT entry.
         int entry[kBatch];
-        for (int l = 0; l < kBatch; ++l) {
-            const float c00 = c000[l] + fx[l] * (c100[l] - c000[l]);
-            const float c10 = c010[l] + fx[l] * (c110[l] - c010[l]);
-            const float c01 = c001[l] + fx[l] * (c101[l] - c001[l]);
-            const float c11 = c011[l] + fx[l] * (c111[l] - c011[l]);
-            const float c0 = c00 + fy[l] * (c10 - c00), c1 = c01 + fy[l] * (c11 - c01);
-            entry[l] = map(c0 + fz[l] * (c1 - c0));
+#if LACUNA_SIMD_SSE41
+        if constexpr (kSimd) {
+            simd::interpolate8(c000, c100, c010, c110, c001, c101, c011, c111, fx, fy, fz, map,
+                               entry);
+        } else
+#endif
+        {
+            for (int l = 0; l < kBatch; ++l) {
+                const float c00 = c000[l] + fx[l] * (c100[l] - c000[l]);
+                const float c10 = c010[l] + fx[l] * (c110[l] - c010[l]);
+                const float c01 = c001[l] + fx[l] * (c101[l] - c001[l]);
+                const float c11 = c011[l] + fx[l] * (c111[l] - c011[l]);
+                const float c0 = c00 + fy[l] * (c10 - c00), c1 = c01 + fy[l] * (c11 - c01);
+                entry[l] = map(c0 + fz[l] * (c1 - c0));
+            }
         }
         // 4. Front-to-back compositing, in order, with early termination.
         for (int l = 0; l < m; ++l) {
