@@ -70,12 +70,14 @@ struct Panel {
         for (int x = xa; x <= xb; ++x) px(x, ya, c), px(x, yb, c);
         for (int y = ya; y <= yb; ++y) px(xa, y, c), px(xb, y, c);
     }
-    void darken(const CellBox& b) const {
+    // Tints a box's inside dark violet (boxes the source skips under the TF).
+    void tint(const CellBox& b) const {
         for (int y = Y(b.hi[1]); y < Y(b.lo[1]); ++y)
             for (int x = X(b.lo[0]); x < X(b.hi[0]); ++x) {
                 if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
                 uint8_t* p = img.pixel(x, y);
-                p[0] = uint8_t(p[0] / 3), p[1] = uint8_t(p[1] / 3), p[2] = uint8_t(p[2] / 3);
+                p[0] = uint8_t((p[0] + 90) / 3), p[1] = uint8_t(p[1] / 3),
+                p[2] = uint8_t((p[2] + 200) / 3);
             }
     }
 };
@@ -104,10 +106,10 @@ Image figure2(const Volume& vol, const GrowingBoxesSource& src, int k, int size)
     // (a) the grown boxes.
     for (const BoxInfo& b : src.grown())
         if (crosses(b.box)) left.rect(b.box, kTypeColour[int(b.type)]);
-    // (b) the BSP leaves after merging; those empty under the TF are darkened.
+    // (b) the BSP leaves after merging; those empty under the TF are tinted.
     for (int32_t id : src.leaves()) {
         const CellBox& b = src.tree().boxes()[size_t(id)].box;
-        if (crosses(b) && src.empty(id)) right.darken(b);
+        if (crosses(b) && src.empty(id)) right.tint(b);
     }
     for (int32_t id : src.leaves()) {
         const CellBox& b = src.tree().boxes()[size_t(id)].box;
@@ -263,7 +265,7 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
         const Image img = figure2(vol, *src, k, a.size);
         write_png(a.out, img);
         std::printf("wrote %s (%dx%d, slice z %d: grown boxes left, BSP leaves right; red "
-                    "uniform, blue gradient, green other; darkened: empty under the TF)\n",
+                    "uniform, blue gradient, green other; tinted violet: empty under the TF)\n",
                     a.out.c_str(), img.width, img.height, k);
     }
 }

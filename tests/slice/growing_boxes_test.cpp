@@ -179,13 +179,13 @@ TEST(GrowingBoxes, BadOptionsNameTheOption) {
     EXPECT_NE(msg(o).find("--thin"), std::string::npos);
 }
 
-// Brute answer for one box: some cell of the box grown by one cell (clipped) has a built range
-// with a visible entry.
+// Brute answer for one box: some cell of the box grown by one cell past its upper faces
+// (clipped) has a built range with a visible entry.
 bool brute_box_visible(const accel_test::BuiltRanges& r, const CellBox& b,
                        const TransferLut& lut) {
-    for (int k = std::max(0, b.lo[2] - 1); k < std::min(r.g.n[2], b.hi[2] + 1); ++k)
-        for (int j = std::max(0, b.lo[1] - 1); j < std::min(r.g.n[1], b.hi[1] + 1); ++j)
-            for (int i = std::max(0, b.lo[0] - 1); i < std::min(r.g.n[0], b.hi[0] + 1); ++i) {
+    for (int k = b.lo[2]; k < std::min(r.g.n[2], b.hi[2] + 1); ++k)
+        for (int j = b.lo[1]; j < std::min(r.g.n[1], b.hi[1] + 1); ++j)
+            for (int i = b.lo[0]; i < std::min(r.g.n[0], b.hi[0] + 1); ++i) {
                 const size_t id = r.g.index(i, j, k);
                 if (accel_test::scan_visible(lut, r.lo[id], r.hi[id])) return true;
             }
@@ -305,7 +305,7 @@ TEST(GrowingBoxesSource, ReturnsDisjointNonEmptyBoxesInVisibilityOrderCoveringVi
 
 TEST(GrowingBoxesSource, RealHeadBuildsAndClassifies) {
     // A real scan: the partition tiles the grid, the classification is non-trivial.
-    const std::string path = "/usr/share/mricron/templates/ch2better.nii.gz";
+    const std::string path = "/usr/share/mricron/templates/ch2.nii.gz";
     const Volume v = read_volume(path);
     GrowingBoxesSource src(v, BoxesOptions{});
     int c[3];
