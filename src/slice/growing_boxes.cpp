@@ -212,8 +212,8 @@ class Grower {
     // data lets them; a face closes for good when its layer breaks the type's rule (header).
     void grow(const int seed[3], BoxType type) {
         int lo[3] = {seed[0], seed[1], seed[2]}, hi[3] = {seed[0] + 1, seed[1] + 1, seed[2] + 1};
-        Facts f{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                0, 0, 0};
+        Facts f{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(), 0,
+                0, 0};
         layer(lo, hi, 0, seed[0], f);
         bool open[6] = {true, true, true, true, true, true};
         for (;;) {
@@ -258,15 +258,15 @@ class Grower {
 
 std::string to_string(BoxType t) {
     switch (t) {
-        case BoxType::Uniform: return "uniform";
-        case BoxType::Gradient: return "gradient";
-        default: return "other";
+        case BoxType::Uniform:
+            return "uniform";
+        case BoxType::Gradient:
+            return "gradient";
+        default:
+            return "other";
     }
 }
 
-int64_t cell_count(const CellBox& b) {
-    return int64_t(b.hi[0] - b.lo[0]) * int64_t(b.hi[1] - b.lo[1]) * int64_t(b.hi[2] - b.lo[2]);
-}
 
 std::string to_string(const CellBox& b) {
     char buf[120];
@@ -321,7 +321,7 @@ BoxMeasure::BoxMeasure(const Volume& v, const BoxesOptions& o) : m_volume(v), m_
 }
 
 BoxType BoxMeasure::type_of(const BoxInfo& i) const {
-    const double vol = double(cell_count(i.box));
+    const double vol = double(box_volume(i.box));
     if (i.gradient_cells > 0 &&
         vol - double(i.gradient_cells) <= double(m_opts.gradient_waste) * vol)
         return BoxType::Gradient;
@@ -330,8 +330,8 @@ BoxType BoxMeasure::type_of(const BoxInfo& i) const {
 }
 
 BoxInfo BoxMeasure::measure(const CellBox& b) const {
-    BoxInfo r{b, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-              0, BoxType::Other};
+    BoxInfo r{b, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(), 0,
+              BoxType::Other};
     const Vec3i d = m_volume.dims();
     const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
     visit_voxels(m_volume, [&](const auto* data) {

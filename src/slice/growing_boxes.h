@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "accel/region.h"
+#include "accel/summed_volume_table.h"  // box_volume
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
 
@@ -71,7 +72,6 @@ struct BoxInfo {
 };
 static_assert(sizeof(BoxInfo) == 48);
 
-int64_t cell_count(const CellBox& b);
 std::string to_string(const CellBox& b);
 
 // TF-independent facts of a volume the growth and the merge rules query: voxel values and the

@@ -18,14 +18,17 @@ using namespace boxes_test;
 // shrunk until it only takes uncovered cells. Not guillotine in general.
 std::vector<CellBox> random_tiling(const int n[3], Rng& rng, int max_edge) {
     std::vector<uint8_t> cov(size_t(n[0]) * n[1] * n[2], 0);
-    auto at = [&](int i, int j, int k) -> uint8_t& { return cov[(size_t(k) * n[1] + j) * n[0] + i]; };
+    auto at = [&](int i, int j, int k) -> uint8_t& {
+        return cov[(size_t(k) * n[1] + j) * n[0] + i];
+    };
     std::vector<CellBox> out;
     for (int k = 0; k < n[2]; ++k)
         for (int j = 0; j < n[1]; ++j)
             for (int i = 0; i < n[0]; ++i) {
                 if (at(i, j, k)) continue;
                 CellBox b{{i, j, k}, {i + 1, j + 1, k + 1}};
-                for (int a = 0; a < 3; ++a) b.hi[a] = std::min(n[a], b.lo[a] + rng.range(1, max_edge));
+                for (int a = 0; a < 3; ++a)
+                    b.hi[a] = std::min(n[a], b.lo[a] + rng.range(1, max_edge));
                 // Shrink x until the first row is free, then y and z layer by layer.
                 for (int x = b.lo[0]; x < b.hi[0]; ++x)
                     if (at(x, j, k)) b.hi[0] = x;
@@ -90,7 +93,7 @@ void check_orders(const BspTree& t, const int n[3], Rng& rng, const std::string&
         const bool is_dir = view % 2 == 1;
         double key[3];
         for (int a = 0; a < 3; ++a)
-            key[a] = is_dir ? double(rng.uniform() * 2 - 1)
+            key[a] = is_dir     ? double(rng.uniform() * 2 - 1)
                      : view < 4 ? double(n[a]) * double(rng.uniform())  // inside the room
                                 : double(n[a]) * (double(rng.uniform()) * 10 - 5);
         if (is_dir && view == 7) key[rng.range(0, 2)] = 0;  // rays parallel to a plane
@@ -154,8 +157,8 @@ TEST(BspTree, MergingPreservesCoverageAndOrder) {
         size_t calls = 0;
         t.merge([&](int32_t a, int32_t b, const CellBox& m) {
             // The rule sees two leaves whose union is the merged box.
-            EXPECT_EQ(cell_count(t.boxes()[size_t(a)].box) + cell_count(t.boxes()[size_t(b)].box),
-                      cell_count(m));
+            EXPECT_EQ(box_volume(t.boxes()[size_t(a)].box) + box_volume(t.boxes()[size_t(b)].box),
+                      box_volume(m));
             EXPECT_TRUE(inside(t.boxes()[size_t(a)].box, m));
             EXPECT_TRUE(inside(t.boxes()[size_t(b)].box, m));
             ++calls;
