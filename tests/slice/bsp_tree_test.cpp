@@ -97,6 +97,8 @@ void check_orders(const BspTree& t, const int n[3], Rng& rng, const std::string&
                      : view < 4 ? double(n[a]) * double(rng.uniform())  // inside the room
                                 : double(n[a]) * (double(rng.uniform()) * 10 - 5);
         if (is_dir && view == 7) key[rng.range(0, 2)] = 0;  // rays parallel to a plane
+        if (view == 2)  // an eye on split planes (integer cell coordinates)
+            for (int a = 0; a < 3; ++a) key[a] = double(rng.range(0, n[a]));
         const Vec3f k{float(key[0]), float(key[1]), float(key[2])};
         for (int a = 0; a < 3; ++a) key[a] = double(k[a]);
         std::vector<int32_t> ids;
@@ -133,6 +135,26 @@ TEST(BspTree, PinwheelNeedsExactlyOneCut) {
     EXPECT_EQ(t.stats().leaves, 6u);
     Rng rng{9};
     check_orders(t, n, rng, "pinwheel");
+}
+
+TEST(BspTree, TheOrderOracleCatchesAReversedOrder) {
+    // The pairwise oracle is not vacuous: back to front fails it, front to back passes.
+    Rng rng{3};
+    const int n[3] = {8, 7, 6};
+    const std::vector<CellBox> in = random_tiling(n, rng, 3);
+    BspTree t;
+    t.build(in, CellBox{{0, 0, 0}, {8, 7, 6}});
+    const double eye[3] = {-5.5, 3.25, 2.75};
+    std::vector<int32_t> ids;
+    t.order(Vec3f{-5.5f, 3.25f, 2.75f}, ids);
+    std::vector<CellBox> order;
+    for (int32_t id : ids) order.push_back(t.boxes()[size_t(id)].box);
+    expect_visibility_order(order, eye, false, "front to back");
+    bool caught = false;
+    for (size_t i = 0; i < order.size() && !caught; ++i)
+        for (size_t j = i + 1; j < order.size() && !caught; ++j)
+            caught = hides(order[i], order[j], eye, false);
+    EXPECT_TRUE(caught) << "reversing the order must break it";
 }
 
 TEST(BspTree, ChoosesThePlaneThatCutsFewestBoxes) {

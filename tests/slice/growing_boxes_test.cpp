@@ -306,6 +306,25 @@ TEST(GrowingBoxesSource, ReturnsDisjointNonEmptyBoxesInVisibilityOrderCoveringVi
     }
 }
 
+TEST(GrowingBoxesSource, SameBoxesForAnyThreadCount) {
+    Rng rng{41};
+    for (int iter = 0; iter < 8; ++iter) {
+        const Volume v = adversarial_volume(4 + iter % 2, accel_test::kAllTypes[iter % 4], rng);
+        BoxesOptions o = random_options(rng);
+        o.threads = 1;
+        GrowingBoxesSource one(v, o);
+        o.threads = 2;
+        GrowingBoxesSource two(v, o);
+        const TransferLut lut = accel_test::random_lut(v.vis_range(), kDefaultLutSize, rng);
+        one.set_transfer_function(lut);
+        two.set_transfer_function(lut);
+        const std::vector<CellBox> a = one.boxes_front_to_back(Vec3f{-3, 40, 7}),
+                                   b = two.boxes_front_to_back(Vec3f{-3, 40, 7});
+        ASSERT_EQ(a.size(), b.size());
+        for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(to_string(a[i]), to_string(b[i]));
+    }
+}
+
 TEST(GrowingBoxesSource, RealHeadBuildsAndClassifies) {
     // A real scan: the partition tiles the grid, the classification is non-trivial.
     const std::string path = "/usr/share/mricron/templates/ch2.nii.gz";
