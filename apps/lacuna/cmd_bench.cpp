@@ -224,6 +224,8 @@ void run_faludi(FaludiArgs& a) {
 void register_bench(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Benchmarks (docs/benchmarks.md)");
     cmd->require_subcommand(1);
+    void register_bench_li(CLI::App&);  // cmd_bench_li.cpp
+    register_bench_li(*cmd);
 
     auto a = std::make_shared<FaludiArgs>();
     auto* f = cmd->add_subcommand(

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "cli_common.h"
+#include "render_slice.h"
 #include "core/parallel.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
@@ -40,6 +41,7 @@ struct RenderArgs {
     int leaf = 8, bits = 64, initial_level = -1;
     bool top_down = false;
     std::string background = "0,0,0";
+    SliceCliArgs slice;  // --renderer, --occlusion* (render_slice.h)
 };
 
 Vec3f parse_rgb(const std::string& s) {
@@ -208,6 +210,11 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 
 void run(RenderArgs& a) {
     const Setup s = validate(a);
+    check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
+    if (a.slice.renderer == "slice") {
+        render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
+        return;
+    }
     if (a.tf_animate.empty())
         render_one(a, s);
     else
@@ -257,7 +264,10 @@ void register_render(CLI::App& app) {
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--background", a->background, "Background colour R,G,B in [0,1]")
         ->capture_default_str();
+    add_slice_options(*cmd, a->slice);
     cmd->callback([a, cmd] {
+        a->slice.threshold_given = cmd->count("--occlusion-threshold") > 0;
+        a->slice.map_given = cmd->count("--occlusion-map") > 0;
         a->azimuth_given = cmd->count("--azimuth") > 0;
         a->elevation_given = cmd->count("--elevation") > 0;
         run(*a);
