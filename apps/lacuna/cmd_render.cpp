@@ -11,6 +11,7 @@
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
+#include "segments_cli.h"
 
 namespace lacuna::cli {
 
@@ -41,6 +42,7 @@ struct RenderArgs {
     int leaf = 8, bits = 64, initial_level = -1;
     bool top_down = false;
     std::string background = "0,0,0";
+    SegmentArgs segments;
     SliceCliArgs slice;  // --renderer, --occlusion* (render_slice.h)
 };
 
@@ -91,7 +93,8 @@ Setup validate(RenderArgs& a) {
         if (!a.elevation_given) a.elevation = kDemoElevation;
     }
     if (a.volume.path.empty()) throw Error("render", "volume", "expected a volume file (or --demo)");
-    if (a.tf.empty() && a.tf_animate.empty())
+    const bool labels_alone = a.segments.mode == "labels";
+    if (a.tf.empty() && a.tf_animate.empty() && !labels_alone)
         throw Error("render", "--tf", "expected a preset name or a .json file");
     if (a.out.empty()) throw Error("render", "--out", "expected an output .png file");
     check_output_path(a.out, ".png");
@@ -212,10 +215,17 @@ void run(RenderArgs& a) {
     const Setup s = validate(a);
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
     if (a.slice.renderer == "slice") {
+        if (a.segments.active())
+            throw Error("--renderer", "segments", "--labels/--segments only with --renderer march");
         render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
         return;
     }
-    if (a.tf_animate.empty())
+    if (a.segments.active()) {
+        if (!a.tf_animate.empty())
+            throw Error("--tf-animate", "segments", "not available with --labels/--segments");
+        render_segments(a.segments, SegmentFrame{a.volume, a.tf, a.accel, a.leaf, a.bits, s.ro,
+                                                 s.op, s.w, s.h, a.out, a.heatmap});
+    } else if (a.tf_animate.empty())
         render_one(a, s);
     else
         render_animation(a, s);
@@ -264,6 +274,7 @@ void register_render(CLI::App& app) {
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--background", a->background, "Background colour R,G,B in [0,1]")
         ->capture_default_str();
+    add_segment_args(*cmd, a->segments);
     add_slice_options(*cmd, a->slice);
     cmd->callback([a, cmd] {
         a->slice.threshold_given = cmd->count("--occlusion-threshold") > 0;

@@ -23,7 +23,7 @@ namespace lacuna::bench {
 
 struct LiOptions {
     OrbitSpec orbit{8, 192, 20.f};
-    std::string ess = "kdtree";  // box source of the ESS columns
+    std::string ess = "boxes";  // box source of the ESS columns
     AccelOptions accel;
     float step = 0.5f;
     float threshold = 0.95f;

@@ -93,6 +93,8 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
         AccelOptions ao;
         auto kd = make_box_source("kdtree", c.volume, ao);
         kd->set_transfer_function(c.lut);
+        auto boxes = make_box_source("boxes", c.volume, ao);
+        boxes->set_transfer_function(c.lut);
         RandomBspSource bsp(c.volume, rng.next(), 7);
         bsp.set_transfer_function(c.lut);
         for (int view = 0; view < 6; ++view) {
@@ -111,6 +113,9 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
             r.set_box_source(&bsp);
             const SliceResult b = r.render(cam, o);
             expect_same(b, basic, what + " random bsp");
+            r.set_box_source(boxes.get());
+            const SliceResult gb = r.render(cam, o);
+            expect_same(gb, basic, what + " growing boxes");
             EXPECT_LE(a.stats.samples, basic.stats.samples);
             if (HasFatalFailure()) return;
         }
