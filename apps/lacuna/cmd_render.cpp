@@ -214,18 +214,20 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 void run(RenderArgs& a) {
     const Setup s = validate(a);
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
-    if (a.slice.renderer == "slice") {
-        if (a.segments.active())
-            throw Error("--renderer", "segments", "--labels/--segments only with --renderer march");
-        render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
-        return;
-    }
     if (a.segments.active()) {
         if (!a.tf_animate.empty())
             throw Error("--tf-animate", "segments", "not available with --labels/--segments");
+        if (a.slice.renderer == "slice")
+            throw Error("--renderer", "segments", "segments are rendered by the ray marcher only");
         render_segments(a.segments, SegmentFrame{a.volume, a.tf, a.accel, a.leaf, a.bits, s.ro,
                                                  s.op, s.w, s.h, a.out, a.heatmap});
-    } else if (a.tf_animate.empty())
+        return;
+    }
+    if (a.slice.renderer == "slice") {
+        render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
+        return;
+    }
+    if (a.tf_animate.empty())
         render_one(a, s);
     else
         render_animation(a, s);
