@@ -20,7 +20,7 @@ struct LiArgs {
     int size = 192, views = 8;
     float elevation = 20.f;
     std::string datasets = "ch2-skin,ch2bet-brain";
-    std::string ess = "kdtree";
+    std::string ess = "boxes";
     float step = 0.5f, threshold = 0.95f;
     int map = 64, updates = 9, threads = 0;
     bool no_march = false;

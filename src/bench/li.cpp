@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 
 #include "bench/stats.h"
 #include "lacuna/error.h"
@@ -24,10 +25,15 @@ double fps(const LiColumn* c) { return c && c->mean_ms > 0 ? 1e3 / c->mean_ms : 
 double ratio(const LiColumn* a, const LiColumn* b) {
     return a && b && b->mean_ms > 0 ? a->mean_ms / b->mean_ms : 0;
 }
+double cpu_ratio(const LiColumn* a, const LiColumn* b) {
+    return a && b && b->cpu_ms > 0 ? a->cpu_ms / b->cpu_ms : 0;
+}
+double cpu_now_ms() { return 1e3 * double(std::clock()) / CLOCKS_PER_SEC; }
 
 void finish(LiColumn& c) {
     c.mean_ms = mean(c.frame_ms);
     const double n = double(std::max<size_t>(c.frame_ms.size(), 1));
+    c.cpu_ms /= n;
     c.setup_fraction /= n;
     c.culled /= n;
     c.clipped /= n;
@@ -79,7 +85,9 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
                 so.occlusion.threshold = o.threshold;
                 so.occlusion.map_size = o.map_size;
                 so.occlusion.updates = o.initial_updates;
+                const double cpu0 = cpu_now_ms();
                 SliceResult r = slicer.render(cams[v], so, adaptive ? &controller : nullptr);
+                col.cpu_ms += cpu_now_ms() - cpu0;
                 col.frame_ms.push_back(r.stats.seconds * 1e3);
                 col.setup_fraction += r.stats.setup_fraction();
                 col.culled += r.stats.culled_fraction();
@@ -126,7 +134,9 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
                 m.set_accel(accel.get());
                 LiColumn col;
                 col.name = name;
+                const double cpu0 = cpu_now_ms();
                 const OrbitRun run_m = run_orbit(m, cams, ro);
+                col.cpu_ms = cpu_now_ms() - cpu0;
                 for (double s : run_m.frame_seconds) col.frame_ms.push_back(s * 1e3);
                 col.samples = double(run_m.samples);
                 finish(col);
@@ -203,6 +213,22 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
            "(ESS+CC). Speedups: ESS = Basic/ESS, CC = ESS/(ESS+CC), ESS+CC = Basic/(ESS+CC), "
            "all from this run.\n\n";
 
+    out += "## CPU time per frame (all threads) and the speedups it gives\n\n";
+    out += "Wall-clock frame rates above depend on what else the machine runs; process CPU time "
+           "per frame counts only this run's work.\n\n";
+    out += "| dataset | Basic | ESS | ESS+CC | ESS+M | ESS+C | march none | speedup ESS | CC | "
+           "ESS+CC | slicer Basic / march none |\n";
+    out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const LiDataset& d : r.datasets) {
+        const LiColumn *b = d.find("Basic"), *e = d.find("ESS"), *cc = d.find("ESS+CC"),
+                       *m = d.find("ESS+M"), *c = d.find("ESS+C"), *mn = d.find("march none");
+        auto cpu = [](const LiColumn* x) { return x ? fmt("%.0f", x->cpu_ms) : std::string("–"); };
+        out += "| " + d.name + " | " + cpu(b) + " | " + cpu(e) + " | " + cpu(cc) + " | " + cpu(m) +
+               " | " + cpu(c) + " | " + cpu(mn) + " | " + fmt("%.2f", cpu_ratio(b, e)) + " | " +
+               fmt("%.2f", cpu_ratio(e, cc)) + " | " + fmt("%.2f", cpu_ratio(b, cc)) + " | " +
+               fmt("%.2f", cpu_ratio(b, mn)) + " |\n";
+    }
+    out += "\n(ms of CPU per frame.)\n\n";
     out += "## Details\n\n";
     out += "| dataset | TF | source build [ms] | box voxels % | Basic [ms] | ESS [ms] | ESS+CC [ms] | "
            "ESS+M [ms] | ESS+C [ms] | march none [ms] | march ESS [ms] | ESS+M == ESS | max "
@@ -232,10 +258,12 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
 }
 
 std::string li_csv(const LiReport& r) {
-    std::string out = "dataset,column,mean_ms,fps,setup_fraction,culled,clipped,samples_per_frame\n";
+    std::string out =
+        "dataset,column,mean_ms,cpu_ms,fps,setup_fraction,culled,clipped,samples_per_frame\n";
     for (const LiDataset& d : r.datasets)
         for (const LiColumn& c : d.columns)
-            out += d.name + "," + c.name + "," + fmt("%.3f", c.mean_ms) + "," + fmt("%.3f", fps(&c)) +
+            out += d.name + "," + c.name + "," + fmt("%.3f", c.mean_ms) + "," +
+                   fmt("%.3f", c.cpu_ms) + "," + fmt("%.3f", fps(&c)) +
                    "," + fmt("%.4f", c.setup_fraction) + "," + fmt("%.4f", c.culled) + "," +
                    fmt("%.4f", c.clipped) + "," + fmt("%.0f", c.samples) + "\n";
     return out;

@@ -23,7 +23,7 @@ namespace lacuna::bench {
 
 struct LiOptions {
     OrbitSpec orbit{8, 192, 20.f};
-    std::string ess = "kdtree";  // box source of the ESS columns
+    std::string ess = "boxes";  // box source of the ESS columns
     AccelOptions accel;
     float step = 0.5f;
     float threshold = 0.95f;
@@ -37,6 +37,8 @@ struct LiColumn {
     std::string name;           // "Basic", "ESS", ...
     std::vector<double> frame_ms;
     double mean_ms = 0;
+    double cpu_ms = 0;          // mean process CPU time per frame (all threads; robust to a
+                                // machine shared with other jobs)
     double setup_fraction = 0;  // mean polygon set-up share of the frame
     double culled = 0, clipped = 0;  // mean shares of non-empty voxels
     double samples = 0;             // mean composited samples per frame

@@ -2,6 +2,7 @@
 
 #include "accel/kdtree.h"
 #include "lacuna/error.h"
+#include "slice/growing_boxes_source.h"
 
 namespace lacuna {
 
@@ -36,9 +37,11 @@ std::unique_ptr<BoxSource> make_box_source(const std::string& name, const Volume
                                            const AccelOptions& options) {
     if (name == "none") return std::make_unique<VolumeBoxSource>(volume);
     if (name == "kdtree") return std::make_unique<KdTreeBoxSource>(volume, options);
-    if (name == "boxes")
-        throw Error("--accel", "box source",
-                    "'boxes' (growing boxes + BSP tree) is not built into this lacuna yet");
+    if (name == "boxes") {
+        BoxesOptions bo;  // the paper's settings (growing_boxes.h)
+        bo.threads = options.threads;
+        return make_growing_boxes_source(volume, bo);
+    }
     throw Error("--accel", "box source",
                 "the slice renderer takes none, kdtree or boxes, not '" + name + "'");
 }

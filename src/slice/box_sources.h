@@ -25,7 +25,7 @@ class VolumeBoxSource final : public BoxSource {
     CellBox m_box;
 };
 
-// Names make_box_source accepts.
+// Names make_box_source accepts ("boxes" with the default BoxesOptions of growing_boxes.h).
 std::vector<std::string> box_source_names();
 // Builds the source `name` over `volume` (which must outlive it). Throws lacuna::Error
 // ("--accel", "box source", ...) for an unknown name or one the slicer cannot use.

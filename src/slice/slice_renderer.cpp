@@ -161,6 +161,10 @@ inline bool span_at(const float* uv, int n, float v, float& u0, float& u1) {
     return u0 <= u1;
 }
 
+// Pixels tried beyond a polygon's projected outline. The polygon comes from the box widened by
+// 1e-3 voxel, computed in double; the margin covers the float rounding of its screen position.
+constexpr float kMargin = 0.05f;
+
 // Composites the boxes of one batch into the tile [x0, x1) x [y0, y1), box after box, each
 // polygon front to back.
 template <class T>
@@ -179,18 +183,21 @@ void raster_tile(const kernel::Grid<T, int64_t>& g, const Rgba* lut, ValueToLut 
             const float zk = (float(p.k) + 0.5f) * dt;  // the plane, independent of the box
             // Rows and columns clamped to the tile before converting (vertices near the eye
             // can project far off screen).
-            const int ya = int(std::ceil(std::clamp(p.vmin - 0.5f, float(y0) + 1.f, float(y1)))) - 1;
-            const int yb =
-                std::min(y1 - 1, int(std::floor(std::clamp(p.vmax - 0.5f, float(y0) - 2.f, float(y1)))) + 1);
+            const int ya = std::max(
+                y0, int(std::ceil(std::clamp(p.vmin - 0.5f - kMargin, float(y0) - 1.f, float(y1)))));
+            const int yb = std::min(
+                y1 - 1, int(std::floor(std::clamp(p.vmax - 0.5f + kMargin, float(y0) - 1.f, float(y1)))));
             for (int y = ya; y <= yb; ++y) {
                 float u0, u1;
                 const float vc = std::clamp(float(y) + 0.5f, p.vmin, p.vmax);
                 if (!span_at(uv, p.count, vc, u0, u1)) continue;
-                // Every pixel whose sample on this plane may lie in the box, with a margin of
-                // one pixel for rounding; the ownership test below decides.
-                const int xa = int(std::ceil(std::clamp(u0 - 0.5f, float(x0) + 1.f, float(x1)))) - 1;
+                // Every pixel whose sample on this plane may lie in the box (a pixel's samples
+                // project exactly onto its centre), with a rounding margin; the ownership test
+                // below decides.
+                const int xa = std::max(
+                    x0, int(std::ceil(std::clamp(u0 - 0.5f - kMargin, float(x0) - 1.f, float(x1)))));
                 const int xb = std::min(
-                    x1 - 1, int(std::floor(std::clamp(u1 - 0.5f, float(x0) - 2.f, float(x1)))) + 1);
+                    x1 - 1, int(std::floor(std::clamp(u1 - 0.5f + kMargin, float(x0) - 1.f, float(x1)))));
                 for (int x = xa; x <= xb; ++x) {
                     const size_t i = size_t(y) * size_t(width) + size_t(x);
                     kernel::Accum& acc = fb[i];

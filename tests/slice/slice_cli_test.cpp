@@ -66,7 +66,8 @@ TEST(SliceCli, EveryBoxSourceAndThresholdOneWriteTheBasicBytes) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("slice renderer"), std::string::npos) << r.out;
     for (const std::string extra : {"--accel kdtree", "--accel kdtree --occlusion --occlusion-threshold 1",
-                                    "--accel kdtree --ortho --azimuth 100", "--threads 1"}) {
+                                    "--accel kdtree --ortho --azimuth 100", "--threads 1",
+                                    "--accel boxes", "--accel boxes --occlusion --occlusion-threshold 1"}) {
         const fs::path png = temp_dir() / "x.png";
         r = run("render " + v + " --tf mr-default --size 40 --renderer slice " + extra + " --out " +
                 png.string());

@@ -32,11 +32,12 @@ TransferFunction band_tf(double a, double b, float opacity) {
     return tf;
 }
 
-Camera random_camera(const SliceRenderer& r, Rng& rng, int size, bool inside = false) {
+Camera random_camera(const SliceRenderer& r, Rng& rng, int size, bool inside = false,
+                     float zoom = 0.f) {
     OrbitParams p;
     p.azimuth_deg = 360.f * rng.uniform();
     p.elevation_deg = -80.f + 160.f * rng.uniform();
-    p.zoom = 0.7f + 2.f * rng.uniform();
+    p.zoom = zoom > 0.f ? zoom : 0.7f + 2.f * rng.uniform();
     p.projection = rng.coin() ? Projection::Orthographic : Projection::Perspective;
     if (inside) {
         p.projection = Projection::Perspective;
@@ -93,10 +94,13 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
         AccelOptions ao;
         auto kd = make_box_source("kdtree", c.volume, ao);
         kd->set_transfer_function(c.lut);
+        auto boxes = make_box_source("boxes", c.volume, ao);
+        boxes->set_transfer_function(c.lut);
         RandomBspSource bsp(c.volume, rng.next(), 7);
         bsp.set_transfer_function(c.lut);
-        for (int view = 0; view < 6; ++view) {
-            const Camera cam = random_camera(r, rng, 40, view == 5);
+        for (int view = 0; view < 10; ++view) {
+            // View 5: eye inside the volume; view 7: voxels smaller than a pixel.
+            const Camera cam = random_camera(r, rng, view == 7 ? 23 : 40, view == 5, view == 7 ? 0.3f : 0.f);
             SliceOptions o;
             o.keep_float = true;
             o.ert = view % 2 ? 0.95f : 2.f;
@@ -111,6 +115,9 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
             r.set_box_source(&bsp);
             const SliceResult b = r.render(cam, o);
             expect_same(b, basic, what + " random bsp");
+            r.set_box_source(boxes.get());
+            const SliceResult gb = r.render(cam, o);
+            expect_same(gb, basic, what + " growing boxes");
             EXPECT_LE(a.stats.samples, basic.stats.samples);
             if (HasFatalFailure()) return;
         }
