@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "cli_common.h"
+#include "render_slice.h"
 #include "core/parallel.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
@@ -42,6 +43,7 @@ struct RenderArgs {
     bool top_down = false;
     std::string background = "0,0,0";
     SegmentArgs segments;
+    SliceCliArgs slice;  // --renderer, --occlusion* (render_slice.h)
 };
 
 Vec3f parse_rgb(const std::string& s) {
@@ -211,12 +213,21 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 
 void run(RenderArgs& a) {
     const Setup s = validate(a);
+    check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
     if (a.segments.active()) {
         if (!a.tf_animate.empty())
             throw Error("--tf-animate", "segments", "not available with --labels/--segments");
+        if (a.slice.renderer == "slice")
+            throw Error("--renderer", "segments", "segments are rendered by the ray marcher only");
         render_segments(a.segments, SegmentFrame{a.volume, a.tf, a.accel, a.leaf, a.bits, s.ro,
                                                  s.op, s.w, s.h, a.out, a.heatmap});
-    } else if (a.tf_animate.empty())
+        return;
+    }
+    if (a.slice.renderer == "slice") {
+        render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
+        return;
+    }
+    if (a.tf_animate.empty())
         render_one(a, s);
     else
         render_animation(a, s);
@@ -266,7 +277,10 @@ void register_render(CLI::App& app) {
     cmd->add_option("--background", a->background, "Background colour R,G,B in [0,1]")
         ->capture_default_str();
     add_segment_args(*cmd, a->segments);
+    add_slice_options(*cmd, a->slice);
     cmd->callback([a, cmd] {
+        a->slice.threshold_given = cmd->count("--occlusion-threshold") > 0;
+        a->slice.map_given = cmd->count("--occlusion-map") > 0;
         a->azimuth_given = cmd->count("--azimuth") > 0;
         a->elevation_given = cmd->count("--elevation") > 0;
         run(*a);

@@ -70,12 +70,14 @@ struct Panel {
         for (int x = xa; x <= xb; ++x) px(x, ya, c), px(x, yb, c);
         for (int y = ya; y <= yb; ++y) px(xa, y, c), px(xb, y, c);
     }
-    void darken(const CellBox& b) const {
+    // Tints a box's inside dark violet (boxes the source skips under the TF).
+    void tint(const CellBox& b) const {
         for (int y = Y(b.hi[1]); y < Y(b.lo[1]); ++y)
             for (int x = X(b.lo[0]); x < X(b.hi[0]); ++x) {
                 if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
                 uint8_t* p = img.pixel(x, y);
-                p[0] = uint8_t(p[0] / 3), p[1] = uint8_t(p[1] / 3), p[2] = uint8_t(p[2] / 3);
+                p[0] = uint8_t((p[0] + 90) / 3), p[1] = uint8_t(p[1] / 3),
+                p[2] = uint8_t((p[2] + 200) / 3);
             }
     }
 };
@@ -104,10 +106,10 @@ Image figure2(const Volume& vol, const GrowingBoxesSource& src, int k, int size)
     // (a) the grown boxes.
     for (const BoxInfo& b : src.grown())
         if (crosses(b.box)) left.rect(b.box, kTypeColour[int(b.type)]);
-    // (b) the BSP leaves after merging; those empty under the TF are darkened.
+    // (b) the BSP leaves after merging; those empty under the TF are tinted.
     for (int32_t id : src.leaves()) {
         const CellBox& b = src.tree().boxes()[size_t(id)].box;
-        if (crosses(b) && src.empty(id)) right.darken(b);
+        if (crosses(b) && src.empty(id)) right.tint(b);
     }
     for (int32_t id : src.leaves()) {
         const CellBox& b = src.tree().boxes()[size_t(id)].box;
@@ -119,7 +121,7 @@ Image figure2(const Volume& vol, const GrowingBoxesSource& src, int k, int size)
 nlohmann::json box_json(const CellBox& b) {
     return {{"lo", {b.lo[0], b.lo[1], b.lo[2]}},
             {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
-            {"cells", cell_count(b)}};
+            {"cells", box_volume(b)}};
 }
 
 }  // namespace
@@ -165,36 +167,39 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
     OrbitParams op;
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
-    const Box3f bounds{{0, 0, 0},
-                       {float(double(d.x - 1) * vol.spacing.x), float(double(d.y - 1) * vol.spacing.y),
-                        float(double(d.z - 1) * vol.spacing.z)}};
+    const Box3f bounds{
+        {0, 0, 0},
+        {float(double(d.x - 1) * vol.spacing.x), float(double(d.y - 1) * vol.spacing.y),
+         float(double(d.z - 1) * vol.spacing.z)}};
     const Camera cam = Camera::orbit(bounds, op, 64, 64);
     const Vec3f eye{float(cam.eye().x / vol.spacing.x), float(cam.eye().y / vol.spacing.y),
                     float(cam.eye().z / vol.spacing.z)};
 
     uint64_t visible_cells = 0;
     for (int32_t id : src->leaves())
-        if (!src->empty(id)) visible_cells += uint64_t(cell_count(src->tree().boxes()[size_t(id)].box));
+        if (!src->empty(id))
+            visible_cells += uint64_t(box_volume(src->tree().boxes()[size_t(id)].box));
     const uint64_t total_cells = uint64_t(d.x - 1) * uint64_t(d.y - 1) * uint64_t(d.z - 1);
 
-    std::printf("%s: %dx%dx%d, growing boxes + orthogonal BSP tree, TF %s\n",
-                a.volume_path.c_str(), d.x, d.y, d.z, tf.name.c_str());
+    std::printf("%s: %dx%dx%d, growing boxes + orthogonal BSP tree, TF %s\n", a.volume_path.c_str(),
+                d.x, d.y, d.z, tf.name.c_str());
     std::printf("settings: %s, %d threads\n", to_string(a.options).c_str(),
                 resolve_threads(a.options.threads));
     std::printf("boxes grown: %zu (uniform %zu, gradient %zu, other %zu)\n", s.grown,
                 s.grown_by_type[0], s.grown_by_type[1], s.grown_by_type[2]);
-    std::printf("after BSP splits: %zu (depth %d); after merges: %zu (uniform %zu, gradient %zu, "
-                "other %zu); sub-volumes (parents kept): %zu\n",
-                s.after_split, s.depth, s.after_merge, s.final_by_type[0], s.final_by_type[1],
-                s.final_by_type[2], s.sub_volumes);
+    std::printf(
+        "after BSP splits: %zu (depth %d); after merges: %zu (uniform %zu, gradient %zu, "
+        "other %zu); sub-volumes (parents kept): %zu\n",
+        s.after_split, s.depth, s.after_merge, s.final_by_type[0], s.final_by_type[1],
+        s.final_by_type[2], s.sub_volumes);
     std::printf("empty under TF: %zu of %zu boxes; visible boxes hold %.1f%% of the cells\n",
                 s.empty, s.after_merge, 100.0 * double(visible_cells) / double(total_cells));
     std::printf(
         "build%s: gradient %.1f ms, grow %.1f ms, split %.1f ms, measure %.1f ms, merge %.1f ms, "
         "ranges %.1f ms (total %.1f ms); TF classification %.3f ms (median of 101)\n",
-        a.repeat > 1 ? (" (median of " + std::to_string(a.repeat) + ")").c_str() : "",
-        t_grad * 1e3, t_grow * 1e3, t_split * 1e3, t_measure * 1e3, t_merge * 1e3,
-        t_ranges * 1e3, t_total * 1e3, t_classify * 1e3);
+        a.repeat > 1 ? (" (median of " + std::to_string(a.repeat) + ")").c_str() : "", t_grad * 1e3,
+        t_grow * 1e3, t_split * 1e3, t_measure * 1e3, t_merge * 1e3, t_ranges * 1e3, t_total * 1e3,
+        t_classify * 1e3);
 
     if (!a.json.empty()) {
         nlohmann::json j;
@@ -213,9 +218,9 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
                          {"thin", o.thin},
                          {"merge", o.merge},
                          {"threads", resolve_threads(o.threads)}};
-        j["timings_ms"] = {{"gradient", ms(t_grad)}, {"grow", ms(t_grow)},
-                           {"split", ms(t_split)},   {"measure", ms(t_measure)},
-                           {"merge", ms(t_merge)},   {"ranges", ms(t_ranges)},
+        j["timings_ms"] = {{"gradient", ms(t_grad)},     {"grow", ms(t_grow)},
+                           {"split", ms(t_split)},       {"measure", ms(t_measure)},
+                           {"merge", ms(t_merge)},       {"ranges", ms(t_ranges)},
                            {"build_total", ms(t_total)}, {"tf_classification", ms(t_classify)},
                            {"repeat", a.repeat}};
         j["counts"] = {{"grown", s.grown},
@@ -262,9 +267,10 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
     if (!a.out.empty()) {
         const Image img = figure2(vol, *src, k, a.size);
         write_png(a.out, img);
-        std::printf("wrote %s (%dx%d, slice z %d: grown boxes left, BSP leaves right; red "
-                    "uniform, blue gradient, green other; darkened: empty under the TF)\n",
-                    a.out.c_str(), img.width, img.height, k);
+        std::printf(
+            "wrote %s (%dx%d, slice z %d: grown boxes left, BSP leaves right; red "
+            "uniform, blue gradient, green other; tinted violet: empty under the TF)\n",
+            a.out.c_str(), img.width, img.height, k);
     }
 }
 

@@ -16,7 +16,7 @@ struct PartitionBoxesArgs {
     int slice = -1;  // cell layer in z for the picture (-1: the middle)
     int size = 512;  // picture: each panel's longer side is about this many pixels
     float azimuth = 30.f, elevation = 20.f;  // the view whose visibility order the JSON lists
-    int repeat = 1;  // builds; median step times are reported
+    int repeat = 1;                          // builds; median step times are reported
 };
 
 // `vol` is loaded (and its --range applied) by the caller.

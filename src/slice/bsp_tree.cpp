@@ -103,8 +103,7 @@ void BspTree::build(const std::vector<CellBox>& input, const CellBox& room) {
             continue;
         }
         const Plane p = choose_plane(m_boxes, w.list, r);
-        if (!p.valid)
-            throw Error("bsp tree", "boxes", "overlap in the room " + to_string(r));
+        if (!p.valid) throw Error("bsp tree", "boxes", "overlap in the room " + to_string(r));
         // Lines 1-2: two children, the room split at the plane.
         const int32_t low = int32_t(m_nodes.size());
         CellBox rl = r, rh = r;

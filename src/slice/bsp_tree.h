@@ -43,7 +43,7 @@ struct BspBox {
 static_assert(sizeof(BspBox) == 32);
 
 // One node. Layout (40 bytes): the room (cells), the index of the low-side child (the high side
-// is front + 1; -1 for a leaf), split axis and plane (index-space plane x_axis = plane: the low
+// is low + 1; -1 for a leaf), split axis and plane (index-space plane x_axis = plane: the low
 // child holds cells < plane), and for a leaf its box (index into boxes()).
 struct BspNode {
     CellBox room;
@@ -57,12 +57,12 @@ struct BspNode {
 static_assert(sizeof(BspNode) == 40);
 
 struct BspStats {
-    size_t input = 0;       // boxes given to build()
-    size_t cut = 0;         // boxes cut by split planes (each cut adds one box)
-    size_t leaves = 0;      // leaves after splitting
-    size_t merged = 0;      // merges done
+    size_t input = 0;   // boxes given to build()
+    size_t cut = 0;     // boxes cut by split planes (each cut adds one box)
+    size_t leaves = 0;  // leaves after splitting
+    size_t merged = 0;  // merges done
     size_t final_leaves = 0;
-    int depth = 0;          // deepest leaf after splitting (root = 0)
+    int depth = 0;  // deepest leaf after splitting (root = 0)
     double split_seconds = 0, merge_seconds = 0;
 };
 

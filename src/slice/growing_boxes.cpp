@@ -207,30 +207,32 @@ class Grower {
         }
     }
 
-    // Grows a box from the seed block: the six faces extend round robin, one block layer at a
-    // time, while the type's rule holds (header); then the box is covered.
+    // Grows a box from the seed block, one block layer at a time: always an open face on the axis
+    // where the box is shortest (ties: +x, -x, +y, -y, +z, -z), so boxes stay as cubic as the
+    // data lets them; a face closes for good when its layer breaks the type's rule (header).
     void grow(const int seed[3], BoxType type) {
         int lo[3] = {seed[0], seed[1], seed[2]}, hi[3] = {seed[0] + 1, seed[1] + 1, seed[2] + 1};
-        Facts f{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                0, 0, 0};
+        Facts f{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(), 0,
+                0, 0};
         layer(lo, hi, 0, seed[0], f);
         bool open[6] = {true, true, true, true, true, true};
-        for (bool any = true; any;) {
-            any = false;
-            for (int face = 0; face < 6; ++face) {
-                if (!open[face]) continue;
-                const int a = face / 2;
-                const bool up = face % 2 == 0;
-                const int pos = up ? hi[a] : lo[a] - 1;
-                Facts g = f;
-                if (pos < 0 || pos >= m_n[a] || !layer(lo, hi, a, pos, g) || !accept(type, f, g)) {
-                    open[face] = false;
-                    continue;
-                }
-                (up ? hi[a] : lo[a]) += up ? 1 : -1;
-                f = g;
-                any = true;
+        for (;;) {
+            int face = -1, best = 0;
+            for (int c = 0; c < 6; ++c) {
+                const int extent = hi[c / 2] - lo[c / 2];
+                if (open[c] && (face < 0 || extent < best)) face = c, best = extent;
             }
+            if (face < 0) break;
+            const int a = face / 2;
+            const bool up = face % 2 == 0;
+            const int pos = up ? hi[a] : lo[a] - 1;
+            Facts g = f;
+            if (pos < 0 || pos >= m_n[a] || !layer(lo, hi, a, pos, g) || !accept(type, f, g)) {
+                open[face] = false;
+                continue;
+            }
+            (up ? hi[a] : lo[a]) += up ? 1 : -1;
+            f = g;
         }
         for (int k = lo[2]; k < hi[2]; ++k)
             for (int j = lo[1]; j < hi[1]; ++j)
@@ -256,15 +258,15 @@ class Grower {
 
 std::string to_string(BoxType t) {
     switch (t) {
-        case BoxType::Uniform: return "uniform";
-        case BoxType::Gradient: return "gradient";
-        default: return "other";
+        case BoxType::Uniform:
+            return "uniform";
+        case BoxType::Gradient:
+            return "gradient";
+        default:
+            return "other";
     }
 }
 
-int64_t cell_count(const CellBox& b) {
-    return int64_t(b.hi[0] - b.lo[0]) * int64_t(b.hi[1] - b.lo[1]) * int64_t(b.hi[2] - b.lo[2]);
-}
 
 std::string to_string(const CellBox& b) {
     char buf[120];
@@ -319,7 +321,7 @@ BoxMeasure::BoxMeasure(const Volume& v, const BoxesOptions& o) : m_volume(v), m_
 }
 
 BoxType BoxMeasure::type_of(const BoxInfo& i) const {
-    const double vol = double(cell_count(i.box));
+    const double vol = double(box_volume(i.box));
     if (i.gradient_cells > 0 &&
         vol - double(i.gradient_cells) <= double(m_opts.gradient_waste) * vol)
         return BoxType::Gradient;
@@ -328,8 +330,8 @@ BoxType BoxMeasure::type_of(const BoxInfo& i) const {
 }
 
 BoxInfo BoxMeasure::measure(const CellBox& b) const {
-    BoxInfo r{b, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-              0, BoxType::Other};
+    BoxInfo r{b, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(), 0,
+              BoxType::Other};
     const Vec3i d = m_volume.dims();
     const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
     visit_voxels(m_volume, [&](const auto* data) {
@@ -380,8 +382,8 @@ void BoxClassifier::build(const Volume& v, ValueRange vis, int lut_size,
         std::copy_n(r.lo, r.n, &clo[at]);
         std::copy_n(r.hi, r.n, &chi[at]);
     });
-    // 2. Per box, the union of the ranges of its cells grown by one cell on every side: a
-    // difference array over the LUT entries, swept into maximal runs.
+    // 2. Per box, the union of the ranges of its cells and of the cells one past its upper faces:
+    // a difference array over the LUT entries, swept into maximal runs.
     std::vector<std::vector<uint16_t>> runs(boxes.size());
     parallel_for(
         boxes.size(), threads,
@@ -391,7 +393,7 @@ void BoxClassifier::build(const Volume& v, ValueRange vis, int lut_size,
                 const CellBox& b = boxes[bi];
                 int lo[3], hi[3];
                 for (int a = 0; a < 3; ++a) {
-                    lo[a] = std::max(0, b.lo[a] - 1);
+                    lo[a] = b.lo[a];
                     hi[a] = std::min(c[a], b.hi[a] + 1);
                 }
                 int first = lut_size, last = -1;

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "accel/region.h"
+#include "accel/summed_volume_table.h"  // box_volume
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
 
@@ -50,9 +51,9 @@ std::string to_string(BoxType t);  // "uniform", "gradient", "other"
 struct BoxesOptions {
     float spread = 32.f;          // uniform: value spread in 256ths of the full scale (paper: 32)
     int min_uniform = 4;          // uniform: smallest extent in cells on every axis
-    float gradient = 0.04f;       // gradient cell: |grad| > gradient x full scale per voxel
+    float gradient = 0.1f;        // gradient cell: |grad| > gradient x full scale per voxel
     float gradient_waste = 0.5f;  // gradient box: non-gradient cells <= this x volume
-    float other_cost = 64.f;      // other box: volume x spread / full scale <= this (cells)
+    float other_cost = 512.f;     // other box: volume x spread / full scale <= this (cells)
     int thin = 2;                 // merge rule 3: a box with an extent < thin cells is thin
     bool merge = true;            // bottom-up merging of the BSP tree (Section 3.2)
     int threads = 0;              // 0 = all
@@ -71,7 +72,6 @@ struct BoxInfo {
 };
 static_assert(sizeof(BoxInfo) == 48);
 
-int64_t cell_count(const CellBox& b);
 std::string to_string(const CellBox& b);
 
 // TF-independent facts of a volume the growth and the merge rules query: voxel values and the
@@ -113,10 +113,11 @@ std::vector<BoxInfo> grow_boxes(const BoxMeasure& m);
 
 // Per transfer function, which boxes are empty. Built once per box list and value->LUT mapping:
 // every box keeps the exact union of the LUT-entry ranges of its cells (for_each_cell_row, the
-// ranges every skipping structure uses), taken over the box grown by one cell on every side
-// (clipped to the grid) because a sample at a box face reads the voxels one past it. Per TF a box
-// is empty exactly when the TF opacity is zero on every entry of that union: the same answer as
-// asking each of those cells, in O(intervals) with the opacity prefix count.
+// ranges every skipping structure uses), taken over the box grown by one cell past each upper
+// face (clipped to the grid): a sample inside the box [lo, hi] reads the cell floor(p), which is
+// cell hi on an upper face (voxel hi+1 with weight zero, counted anyway to be conservative).
+// Per TF a box is empty exactly when the TF opacity is zero on every entry of that union: the
+// same answer as asking each of those cells, in O(intervals) with the opacity prefix count.
 class BoxClassifier {
   public:
     // `vis` and `lut_size` define the value->LUT mapping (TransferLut::map()).

@@ -113,7 +113,6 @@ void GrowingBoxesSource::set_transfer_function(const TransferLut& lut) {
     m_classifier.classify(lut, m_empty);
     m_stats.empty = 0;
     for (uint8_t e : m_empty) m_stats.empty += e;
-    m_tf_set = true;
     m_stats.classify = since(t0);
 }
 

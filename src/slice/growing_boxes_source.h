@@ -42,7 +42,7 @@ class GrowingBoxesSource final : public BoxSource {
     const BspTree& tree() const { return m_tree; }
     const BoxInfo& info(int32_t box) const { return m_info[size_t(box)]; }
     bool empty(int32_t box) const { return m_empty[size_t(m_slot[size_t(box)])] != 0; }
-    const std::vector<int32_t>& leaves() const { return m_leaves; }  // final leaves, tree order
+    const std::vector<int32_t>& leaves() const { return m_leaves; }   // final leaves, tree order
     const BoxClassifier& classifier() const { return m_classifier; }  // indexed like leaves()
     const BoxesBuildStats& stats() const { return m_stats; }
     size_t bytes() const;
@@ -58,7 +58,6 @@ class GrowingBoxesSource final : public BoxSource {
     std::vector<int32_t> m_slot;  // box index -> position in m_leaves (-1: not a final leaf)
     BoxClassifier m_classifier;
     std::vector<uint8_t> m_empty;  // per final leaf (m_leaves order)
-    bool m_tf_set = false;
     BoxesBuildStats m_stats;
 };
 

@@ -18,14 +18,17 @@ using namespace boxes_test;
 // shrunk until it only takes uncovered cells. Not guillotine in general.
 std::vector<CellBox> random_tiling(const int n[3], Rng& rng, int max_edge) {
     std::vector<uint8_t> cov(size_t(n[0]) * n[1] * n[2], 0);
-    auto at = [&](int i, int j, int k) -> uint8_t& { return cov[(size_t(k) * n[1] + j) * n[0] + i]; };
+    auto at = [&](int i, int j, int k) -> uint8_t& {
+        return cov[(size_t(k) * n[1] + j) * n[0] + i];
+    };
     std::vector<CellBox> out;
     for (int k = 0; k < n[2]; ++k)
         for (int j = 0; j < n[1]; ++j)
             for (int i = 0; i < n[0]; ++i) {
                 if (at(i, j, k)) continue;
                 CellBox b{{i, j, k}, {i + 1, j + 1, k + 1}};
-                for (int a = 0; a < 3; ++a) b.hi[a] = std::min(n[a], b.lo[a] + rng.range(1, max_edge));
+                for (int a = 0; a < 3; ++a)
+                    b.hi[a] = std::min(n[a], b.lo[a] + rng.range(1, max_edge));
                 // Shrink x until the first row is free, then y and z layer by layer.
                 for (int x = b.lo[0]; x < b.hi[0]; ++x)
                     if (at(x, j, k)) b.hi[0] = x;
@@ -90,10 +93,12 @@ void check_orders(const BspTree& t, const int n[3], Rng& rng, const std::string&
         const bool is_dir = view % 2 == 1;
         double key[3];
         for (int a = 0; a < 3; ++a)
-            key[a] = is_dir ? double(rng.uniform() * 2 - 1)
+            key[a] = is_dir     ? double(rng.uniform() * 2 - 1)
                      : view < 4 ? double(n[a]) * double(rng.uniform())  // inside the room
                                 : double(n[a]) * (double(rng.uniform()) * 10 - 5);
         if (is_dir && view == 7) key[rng.range(0, 2)] = 0;  // rays parallel to a plane
+        if (view == 2)  // an eye on split planes (integer cell coordinates)
+            for (int a = 0; a < 3; ++a) key[a] = double(rng.range(0, n[a]));
         const Vec3f k{float(key[0]), float(key[1]), float(key[2])};
         for (int a = 0; a < 3; ++a) key[a] = double(k[a]);
         std::vector<int32_t> ids;
@@ -132,6 +137,26 @@ TEST(BspTree, PinwheelNeedsExactlyOneCut) {
     check_orders(t, n, rng, "pinwheel");
 }
 
+TEST(BspTree, TheOrderOracleCatchesAReversedOrder) {
+    // The pairwise oracle is not vacuous: back to front fails it, front to back passes.
+    Rng rng{3};
+    const int n[3] = {8, 7, 6};
+    const std::vector<CellBox> in = random_tiling(n, rng, 3);
+    BspTree t;
+    t.build(in, CellBox{{0, 0, 0}, {8, 7, 6}});
+    const double eye[3] = {-5.5, 3.25, 2.75};
+    std::vector<int32_t> ids;
+    t.order(Vec3f{-5.5f, 3.25f, 2.75f}, ids);
+    std::vector<CellBox> order;
+    for (int32_t id : ids) order.push_back(t.boxes()[size_t(id)].box);
+    expect_visibility_order(order, eye, false, "front to back");
+    bool caught = false;
+    for (size_t i = 0; i < order.size() && !caught; ++i)
+        for (size_t j = i + 1; j < order.size() && !caught; ++j)
+            caught = hides(order[i], order[j], eye, false);
+    EXPECT_TRUE(caught) << "reversing the order must break it";
+}
+
 TEST(BspTree, ChoosesThePlaneThatCutsFewestBoxes) {
     // Two slabs in z over a split in x: the z plane cuts nothing, any x plane cuts the top slab.
     const std::vector<CellBox> in = {CellBox{{0, 0, 0}, {3, 4, 2}}, CellBox{{3, 0, 0}, {8, 4, 2}},
@@ -154,8 +179,8 @@ TEST(BspTree, MergingPreservesCoverageAndOrder) {
         size_t calls = 0;
         t.merge([&](int32_t a, int32_t b, const CellBox& m) {
             // The rule sees two leaves whose union is the merged box.
-            EXPECT_EQ(cell_count(t.boxes()[size_t(a)].box) + cell_count(t.boxes()[size_t(b)].box),
-                      cell_count(m));
+            EXPECT_EQ(box_volume(t.boxes()[size_t(a)].box) + box_volume(t.boxes()[size_t(b)].box),
+                      box_volume(m));
             EXPECT_TRUE(inside(t.boxes()[size_t(a)].box, m));
             EXPECT_TRUE(inside(t.boxes()[size_t(b)].box, m));
             ++calls;

@@ -66,8 +66,8 @@ TEST(GrowingBoxes, PartitionCoversEveryCellExactlyOnceAndKeepsItsRules) {
         const BoxesOptions o = random_options(rng);
         const BoxMeasure m(v, o);
         const std::vector<BoxInfo> grown = grow_boxes(m);
-        const std::string what = "iter " + std::to_string(iter) + " " + to_string(v) + " " +
-                                 to_string(o);
+        const std::string what =
+            "iter " + std::to_string(iter) + " " + to_string(v) + " " + to_string(o);
         int c[3];
         cell_counts(v, c);
         std::vector<CellBox> boxes;
@@ -78,7 +78,8 @@ TEST(GrowingBoxes, PartitionCoversEveryCellExactlyOnceAndKeepsItsRules) {
         for (int k = 0; k < c[2]; ++k)
             for (int j = 0; j < c[1]; ++j)
                 for (int i = 0; i < c[0]; ++i)
-                    ASSERT_EQ(m.gradient_cell(i, j, k), grad[(size_t(k) * c[1] + j) * c[0] + i] != 0)
+                    ASSERT_EQ(m.gradient_cell(i, j, k),
+                              grad[(size_t(k) * c[1] + j) * c[0] + i] != 0)
                         << what << " cell " << i << "," << j << "," << k;
         for (const BoxInfo& b : grown) {
             ASSERT_TRUE(inside(b.box, CellBox{{0, 0, 0}, {c[0], c[1], c[2]}})) << what;
@@ -101,7 +102,7 @@ TEST(GrowingBoxes, PartitionCoversEveryCellExactlyOnceAndKeepsItsRules) {
             }
             // The growth type is what the facts say (type_of), and its rule holds.
             ASSERT_EQ(m.type_of(b), b.type) << what << " " << to_string(b.box);
-            const double vol = double(cell_count(b.box));
+            const double vol = double(box_volume(b.box));
             switch (b.type) {
                 case BoxType::Uniform:
                     // The spread bound over every voxel the box's samples read.
@@ -134,7 +135,7 @@ TEST(GrowingBoxes, ConstantVolumeIsOneUniformBox) {
     const std::vector<BoxInfo> g = grow_boxes(m);
     ASSERT_EQ(g.size(), 1u);
     EXPECT_EQ(g[0].type, BoxType::Uniform);
-    EXPECT_EQ(cell_count(g[0].box), 19 * 12 * 8);
+    EXPECT_EQ(box_volume(g[0].box), 19 * 12 * 8);
 }
 
 TEST(GrowingBoxes, SpreadScalesWithTheVisualizationRange) {
@@ -179,13 +180,12 @@ TEST(GrowingBoxes, BadOptionsNameTheOption) {
     EXPECT_NE(msg(o).find("--thin"), std::string::npos);
 }
 
-// Brute answer for one box: some cell of the box grown by one cell (clipped) has a built range
-// with a visible entry.
-bool brute_box_visible(const accel_test::BuiltRanges& r, const CellBox& b,
-                       const TransferLut& lut) {
-    for (int k = std::max(0, b.lo[2] - 1); k < std::min(r.g.n[2], b.hi[2] + 1); ++k)
-        for (int j = std::max(0, b.lo[1] - 1); j < std::min(r.g.n[1], b.hi[1] + 1); ++j)
-            for (int i = std::max(0, b.lo[0] - 1); i < std::min(r.g.n[0], b.hi[0] + 1); ++i) {
+// Brute answer for one box: some cell of the box grown by one cell past its upper faces
+// (clipped) has a built range with a visible entry.
+bool brute_box_visible(const accel_test::BuiltRanges& r, const CellBox& b, const TransferLut& lut) {
+    for (int k = b.lo[2]; k < std::min(r.g.n[2], b.hi[2] + 1); ++k)
+        for (int j = b.lo[1]; j < std::min(r.g.n[1], b.hi[1] + 1); ++j)
+            for (int i = b.lo[0]; i < std::min(r.g.n[0], b.hi[0] + 1); ++i) {
                 const size_t id = r.g.index(i, j, k);
                 if (accel_test::scan_visible(lut, r.lo[id], r.hi[id])) return true;
             }
@@ -203,14 +203,16 @@ TEST(BoxClassifier, EmptyEqualsBruteForceOverCellsUnderRandomTfs) {
         ValueRange vis = v.vis_range();
         if (size != kDefaultLutSize && rng.coin()) {  // a TF file with its own range
             const float w = std::max(vis.width(), 1.f);
-            vis = ValueRange{vis.min - 0.3f * w * rng.uniform(), vis.max - 0.5f * w * rng.uniform()};
+            vis =
+                ValueRange{vis.min - 0.3f * w * rng.uniform(), vis.max - 0.5f * w * rng.uniform()};
             if (!(vis.max > vis.min)) vis.max = vis.min + 1;
         }
         const ValueToLut map(vis, size);
         const accel_test::BuiltRanges built = accel_test::built_ranges(v, map, -8);
         const accel_test::BruteRanges brute = accel_test::brute_ranges(v, map);
         std::vector<int> hits;
-        for (size_t c = 0; c < built.lo.size(); ++c) hits.push_back(built.lo[c]), hits.push_back(built.hi[c]);
+        for (size_t c = 0; c < built.lo.size(); ++c)
+            hits.push_back(built.lo[c]), hits.push_back(built.hi[c]);
         const std::string what = "iter " + std::to_string(iter) + " " + to_string(v);
         for (int tf = 0; tf < 12; ++tf) {
             TransferLut lut = accel_test::random_lut(vis, size, rng, hits);
@@ -229,7 +231,8 @@ TEST(BoxClassifier, EmptyEqualsBruteForceOverCellsUnderRandomTfs) {
                         for (int j = b.lo[1]; j < b.hi[1]; ++j)
                             for (int i = b.lo[0]; i < b.hi[0]; ++i) {
                                 const size_t c = brute.g.index(i, j, k);
-                                ASSERT_FALSE(accel_test::scan_visible(lut, brute.lo[c], brute.hi[c]))
+                                ASSERT_FALSE(
+                                    accel_test::scan_visible(lut, brute.lo[c], brute.hi[c]))
                                     << what;
                             }
             }
@@ -281,7 +284,7 @@ TEST(GrowingBoxesSource, ReturnsDisjointNonEmptyBoxesInVisibilityOrderCoveringVi
             double key[3];
             const bool is_dir = view % 2 == 1;
             for (int a = 0; a < 3; ++a)
-                key[a] = is_dir ? double(rng.uniform() * 2 - 1)
+                key[a] = is_dir     ? double(rng.uniform() * 2 - 1)
                          : view < 3 ? double(c[a]) * (rng.uniform() * 1.4 - 0.2)  // inside or near
                                     : double(c[a]) * (rng.uniform() * 8 - 4);
             const Vec3f k{float(key[0]), float(key[1]), float(key[2])};
@@ -303,9 +306,28 @@ TEST(GrowingBoxesSource, ReturnsDisjointNonEmptyBoxesInVisibilityOrderCoveringVi
     }
 }
 
+TEST(GrowingBoxesSource, SameBoxesForAnyThreadCount) {
+    Rng rng{41};
+    for (int iter = 0; iter < 8; ++iter) {
+        const Volume v = adversarial_volume(4 + iter % 2, accel_test::kAllTypes[iter % 4], rng);
+        BoxesOptions o = random_options(rng);
+        o.threads = 1;
+        GrowingBoxesSource one(v, o);
+        o.threads = 2;
+        GrowingBoxesSource two(v, o);
+        const TransferLut lut = accel_test::random_lut(v.vis_range(), kDefaultLutSize, rng);
+        one.set_transfer_function(lut);
+        two.set_transfer_function(lut);
+        const std::vector<CellBox> a = one.boxes_front_to_back(Vec3f{-3, 40, 7}),
+                                   b = two.boxes_front_to_back(Vec3f{-3, 40, 7});
+        ASSERT_EQ(a.size(), b.size());
+        for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(to_string(a[i]), to_string(b[i]));
+    }
+}
+
 TEST(GrowingBoxesSource, RealHeadBuildsAndClassifies) {
     // A real scan: the partition tiles the grid, the classification is non-trivial.
-    const std::string path = "/usr/share/mricron/templates/ch2better.nii.gz";
+    const std::string path = "/usr/share/mricron/templates/ch2.nii.gz";
     const Volume v = read_volume(path);
     GrowingBoxesSource src(v, BoxesOptions{});
     int c[3];

@@ -88,9 +88,9 @@ TEST(PartitionBoxesCli, BadOptionsAreOneLineExit2AndWriteNothing) {
          {std::string("--spread -3"), std::string("--min-box 0"), std::string("--gradient 2"),
           std::string("--gradient-waste -0.5"), std::string("--other-cost -1"),
           std::string("--thin -2"), std::string("--slice 999"), std::string("--repeat 0")}) {
-        const CliRun r = run_cli("partition " + volume().string() +
-                                 " --tf mr-default --method boxes " + opt + " --json " +
-                                 json.string());
+        const CliRun r =
+            run_cli("partition " + volume().string() + " --tf mr-default --method boxes " + opt +
+                    " --json " + json.string());
         EXPECT_EQ(r.code, 2) << opt << ": " << r.err;
         const std::string flag = opt.substr(0, opt.find(' '));
         EXPECT_NE(r.err.find(flag), std::string::npos) << opt << ": " << r.err;
