@@ -35,7 +35,8 @@
   let frames = 0;
   let lastFrameAt = 0, fps = 0;
   let lastTfReport = null;
-  let currentUrl = null;
+  let currentUrl = null, pendingUrl = null;
+  const frameLog = [];      // the last 2000 frame headers with their arrival time (scripts)
   let selectedStop = -1;
 
   // ---- connection -------------------------------------------------------------------------
@@ -85,17 +86,24 @@
     const n = bytes[0] | (bytes[1] << 8) | (bytes[2] << 16) | (bytes[3] << 24);
     const header = JSON.parse(new TextDecoder().decode(bytes.subarray(4, 4 + n)));
     const url = URL.createObjectURL(new Blob([bytes.subarray(4 + n)], { type: 'image/jpeg' }));
+    // A frame still decoding when a newer one arrives is superseded: free its blob.
+    const superseded = pendingUrl;
+    pendingUrl = url;
     img.onload = () => {
       if (currentUrl) URL.revokeObjectURL(currentUrl);
       currentUrl = url;
+      pendingUrl = null;
       frames += 1;
       document.body.dataset.frames = String(frames);
     };
     img.src = url;
+    if (superseded) URL.revokeObjectURL(superseded);
     const now = performance.now();
     if (lastFrameAt) fps = 0.8 * fps + 0.2 * (1000 / Math.max(1, now - lastFrameAt));
     lastFrameAt = now;
     showStats(header);
+    frameLog.push({ t: now, ...header });
+    if (frameLog.length > 2000) frameLog.shift();
     if (header.id === inFlight) inFlight = null;
     flush();
   }
@@ -478,6 +486,6 @@
   function round4(v) { return Math.round(v * 10000) / 10000; }
 
   // A small handle for scripts and tests (tests/e2e/viewer.e2e.mjs).
-  window.lacunaViewer = { state, opacityPointClient, frames: () => frames };
+  window.lacunaViewer = { state, opacityPointClient, frames: () => frames, frameLog };
   connect();
 })();

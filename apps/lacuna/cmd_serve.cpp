@@ -41,8 +41,9 @@ void run(const ServeArgs& a) {
     serve::Server server(renderer, so);
     server.start();
     if (a.host != "127.0.0.1" && a.host != "::1")
-        std::printf("warning: listening on %s: anyone who can reach this address can use the viewer\n",
-                    a.host.c_str());
+        std::printf(
+            "warning: listening on %s: anyone who can reach this address can use the viewer\n",
+            a.host.c_str());
     std::printf("lacuna viewer: %s (Ctrl-C stops)\n", server.url().c_str());
     std::fflush(stdout);
     server.run();
@@ -55,15 +56,17 @@ void register_serve(CLI::App& app) {
     auto a = std::make_shared<ServeArgs>();
     auto* cmd = app.add_subcommand("serve", "Interactive viewer in the browser (docs/viewer.md)");
     add_volume_args(*cmd, a->volume);
-    cmd->add_option("--host", a->host,
-                    "Address to listen on (default loopback only; another address exposes the viewer)")
+    cmd->add_option(
+           "--host", a->host,
+           "Address to listen on (default loopback only; another address exposes the viewer)")
         ->capture_default_str();
     cmd->add_option("--port", a->port, "TCP port (0: any free port)")->capture_default_str();
     cmd->add_option("--tf", a->tf, "Initial transfer function: a preset name or a .json file");
     cmd->add_option("--threads", a->threads, "Render threads (0 = all)")->capture_default_str();
     cmd->add_option("--leaf", a->leaf, "Octree leaf edge in cells (2..64, power of two)")
         ->capture_default_str();
-    cmd->add_option("--bits", a->bits, "Bitfield width (8, 16, 32, 64, 128)")->capture_default_str();
+    cmd->add_option("--bits", a->bits, "Bitfield width (8, 16, 32, 64, 128)")
+        ->capture_default_str();
     cmd->callback([a] { run(*a); });
 }
 

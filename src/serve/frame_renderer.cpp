@@ -24,16 +24,19 @@ std::vector<uint64_t> compute_histogram(const Volume& v, int bins, int threads) 
     const double scale = r.max > r.min ? double(bins) / (double(r.max) - double(r.min)) : 0.0;
     std::mutex merge;
     visit_voxels(v, [&](const auto* data) {
-        parallel_for(v.voxel_count(), threads, [&](size_t b, size_t e) {
-            std::vector<uint64_t> local(size_t(bins), 0);
-            for (size_t i = b; i < e; ++i) {
-                const double u = (double(data[i]) - double(r.min)) * scale;
-                const int bin = u < 0 ? 0 : (u >= bins ? bins - 1 : int(u));
-                ++local[size_t(bin)];
-            }
-            std::lock_guard<std::mutex> lock(merge);
-            for (int i = 0; i < bins; ++i) total[size_t(i)] += local[size_t(i)];
-        }, size_t(1) << 20);
+        parallel_for(
+            v.voxel_count(), threads,
+            [&](size_t b, size_t e) {
+                std::vector<uint64_t> local(size_t(bins), 0);
+                for (size_t i = b; i < e; ++i) {
+                    const double u = (double(data[i]) - double(r.min)) * scale;
+                    const int bin = u < 0 ? 0 : (u >= bins ? bins - 1 : int(u));
+                    ++local[size_t(bin)];
+                }
+                std::lock_guard<std::mutex> lock(merge);
+                for (int i = 0; i < bins; ++i) total[size_t(i)] += local[size_t(i)];
+            },
+            size_t(1) << 20);
     });
     return total;
 }
@@ -149,9 +152,7 @@ Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     f.image = std::move(r.image);
     f.stats = r.stats;
     f.lattice_samples = lattice_samples(*m_volume, cam, ro.step, m_threads);
-    f.skipped = f.lattice_samples
-                    ? 1.0 - double(f.stats.samples) / double(f.lattice_samples)
-                    : 0.0;
+    f.skipped = f.lattice_samples ? 1.0 - double(f.stats.samples) / double(f.lattice_samples) : 0.0;
     return f;
 }
 

@@ -22,16 +22,16 @@ namespace lacuna::serve {
 struct Frame {
     Image image;
     RenderStats stats;
-    uint64_t lattice_samples = 0;  // samples the reference (no skipping, no ERT) would take
-    double skipped = 0;            // 1 - samples / lattice_samples
-    bool tf_changed = false;       // this frame applied a TF different from the previous one
-    double tf_update_seconds = 0;  // LUT + marcher + structure update, when tf_changed
-    double accel_build_seconds = 0;  // when this frame built its structure for the first time
+    uint64_t lattice_samples = 0;        // samples the reference (no skipping, no ERT) would take
+    double skipped = 0;                  // 1 - samples / lattice_samples
+    bool tf_changed = false;             // this frame applied a TF different from the previous one
+    double tf_update_seconds = 0;        // LUT + marcher + structure update, when tf_changed
+    double accel_build_seconds = 0;      // when this frame built its structure for the first time
     double accel_tf_update_seconds = 0;  // the structure's last TF update (AccelStats)
 };
 
 class FrameRenderer {
-public:
+  public:
     // threads: render and build threads (0 = all). The renderer keeps the volume.
     FrameRenderer(Volume volume, const AccelOptions& accel_options = {}, int threads = 0);
     ~FrameRenderer();
@@ -51,7 +51,7 @@ public:
     // The marcher's options for a request (what `lacuna render --step S --ert 0.99|1` uses).
     RenderOptions render_options(const ViewRequest& req) const;
 
-private:
+  private:
     Accel& accel(AccelKind k, double& build_seconds);
 
     std::unique_ptr<Volume> m_volume;  // stable address: marcher and structures point at it

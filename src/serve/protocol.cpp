@@ -28,9 +28,12 @@ void check_shape(std::string_view text, const Limits& limits) {
     bool in_string = false, escaped = false;
     for (char c : text) {
         if (in_string) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') in_string = false;
+            if (escaped)
+                escaped = false;
+            else if (c == '\\')
+                escaped = true;
+            else if (c == '"')
+                in_string = false;
         } else if (c == '"') {
             in_string = true;
         } else if (c == '{' || c == '[') {
@@ -110,19 +113,23 @@ uint64_t id_of(const json& j) {
 
 std::string to_string(RendererKind k) {
     switch (k) {
-        case RendererKind::March: return "march";
+        case RendererKind::March:
+            return "march";
     }
     return "?";
 }
 
-std::vector<std::string> renderer_names() { return {"march"}; }
+std::vector<std::string> renderer_names() {
+    return {"march"};
+}
 
 ViewRequest parse_request(std::string_view text, const Limits& limits) {
     const json j = parse_json(text, limits);
     const std::string type = text_of(j, "type", "");
     if (type != "render") reject("type", "unknown message type '" + type + "'; expected render");
-    only_keys(j, {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
-                  "step", "tf"},
+    only_keys(j,
+              {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
+               "step", "tf"},
               "");
     ViewRequest r;
     r.id = id_of(j);

@@ -55,8 +55,8 @@ struct ViewRequest {
     ViewCamera camera;
     RendererKind renderer = RendererKind::March;
     AccelKind accel = AccelKind::None;
-    bool ert = true;     // early ray termination at 0.99 (false: off)
-    float step = 0.5f;   // sample distance in smallest voxel spacings, [0.1, 8]
+    bool ert = true;    // early ray termination at 0.99 (false: off)
+    float step = 0.5f;  // sample distance in smallest voxel spacings, [0.1, 8]
     TransferFunction tf;
 };
 
@@ -70,7 +70,7 @@ struct HelloInfo {
     std::string volume_name;
     const Volume* volume = nullptr;
     std::vector<uint64_t> histogram;  // bins over the visualization range
-    TransferFunction initial_tf;       // the TF the page starts with
+    TransferFunction initial_tf;      // the TF the page starts with
     std::vector<std::string> accels, renderers;
     Limits limits;
 };
@@ -82,14 +82,14 @@ struct FrameInfo {
     int width = 0, height = 0;  // of the JPEG (reduced when preview)
     bool preview = false;
     std::string renderer, accel;
-    double frame_ms = 0;        // the render alone
-    double encode_ms = 0;       // JPEG
+    double frame_ms = 0;   // the render alone
+    double encode_ms = 0;  // JPEG
     double samples_per_ray = 0;
-    double skipped = 0;         // fraction of the box's lattice samples not taken
-    bool tf_changed = false;    // this frame applied a new TF
-    double tf_update_ms = 0;    // TF change -> ready to render (LUT + structure update)
-    double tf_latency_ms = 0;   // TF message received -> ready to render (includes waiting)
-    double accel_build_ms = 0;  // when this frame built the structure first
+    double skipped = 0;             // fraction of the box's lattice samples not taken
+    bool tf_changed = false;        // this frame applied a new TF
+    double tf_update_ms = 0;        // TF change -> ready to render (LUT + structure update)
+    double tf_latency_ms = 0;       // TF message received -> ready to render (includes waiting)
+    double accel_build_ms = 0;      // when this frame built the structure first
     double accel_tf_update_ms = 0;  // the structure's own last TF update (AccelStats)
 };
 std::string frame_header(const FrameInfo& f);

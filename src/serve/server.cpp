@@ -6,13 +6,12 @@
 // render) directly; the rendering itself is parallelised only through core/parallel.h.
 #include "serve/server.h"
 
+#include <algorithm>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
-
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -100,7 +99,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 // One browser tab's WebSocket. Every member except the slot is touched only on the network
 // thread.
 class WsSession : public std::enable_shared_from_this<WsSession> {
-public:
+  public:
     WsSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
         : m_ws(std::move(socket)), m_server(std::move(server)) {}
 
@@ -108,7 +107,8 @@ public:
     void run(http::request<Body, http::basic_fields<Allocator>> req) {
         m_ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
         m_ws.read_message_max(m_server->options.max_frame_bytes);
-        m_ws.async_accept(req, beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
+        m_ws.async_accept(req,
+                          beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
     }
 
     // Queues a text message (hello, errors): these are never dropped.
@@ -132,7 +132,7 @@ public:
     Clock::time_point pending_received;
     bool in_ready = false;
 
-private:
+  private:
     void on_accept(beast::error_code ec) {
         if (ec) return;
         if (m_server->stopping) return close();
@@ -144,7 +144,8 @@ private:
     }
 
     void read() {
-        m_ws.async_read(m_buffer, beast::bind_front_handler(&WsSession::on_read, shared_from_this()));
+        m_ws.async_read(m_buffer,
+                        beast::bind_front_handler(&WsSession::on_read, shared_from_this()));
     }
 
     void on_read(beast::error_code ec, size_t) {
@@ -209,13 +210,13 @@ private:
 
 // One HTTP connection: GET/HEAD of an embedded asset, or the upgrade to /ws.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
-public:
+  public:
     HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
         : m_stream(std::move(socket)), m_server(std::move(server)) {}
 
     void run() { read(); }
 
-private:
+  private:
     void read() {
         m_parser.emplace();
         m_parser->header_limit(8 * 1024);
@@ -237,7 +238,8 @@ private:
         auto req = m_parser->release();
         const std::string host(req[http::field::host]);
         if (m_server->loopback && !is_loopback_name(host_name(host)))
-            return respond(plain(http::status::forbidden, "forbidden host\n", req.version(), false));
+            return respond(
+                plain(http::status::forbidden, "forbidden host\n", req.version(), false));
         if (websocket::is_upgrade(req)) {
             if (req.target() != "/ws")
                 return respond(plain(http::status::not_found, "not found\n", req.version(), false));
@@ -245,7 +247,8 @@ private:
             // hijacking): a browser always sends Origin; it must be this server's own.
             const auto origin = req[http::field::origin];
             if (!origin.empty() && origin != "http://" + host)
-                return respond(plain(http::status::forbidden, "forbidden origin\n", req.version(), false));
+                return respond(
+                    plain(http::status::forbidden, "forbidden origin\n", req.version(), false));
             if (int(m_server->sessions.size()) >= m_server->options.max_sessions)
                 return respond(plain(http::status::service_unavailable, "too many tabs\n",
                                      req.version(), false));
@@ -269,7 +272,8 @@ private:
             res.content_length(a.body.size());
             return respond(std::move(res));
         }
-        return respond(plain(http::status::not_found, "not found\n", req.version(), req.keep_alive()));
+        return respond(
+            plain(http::status::not_found, "not found\n", req.version(), req.keep_alive()));
     }
 
     template <class Res>
@@ -283,8 +287,8 @@ private:
                 "frame-ancestors 'none'");
     }
 
-    static http::response<http::string_body> plain(http::status s, const char* body, unsigned version,
-                                                   bool keep_alive) {
+    static http::response<http::string_body> plain(http::status s, const char* body,
+                                                   unsigned version, bool keep_alive) {
         http::response<http::string_body> res{s, version};
         res.set(http::field::content_type, "text/plain; charset=utf-8");
         secure_headers(res);
@@ -363,8 +367,7 @@ void Server::Impl::render_loop() {
             // Previews (the page is dragging) are reduced so they take about a frame at 30 Hz,
             // judged by the last full-resolution frame: 1/2, 1/3 or 1/4 per side.
             int div = 1;
-            if (req.preview)
-                div = std::clamp(int(std::ceil(std::sqrt(last_full_ms / 33.0))), 2, 4);
+            if (req.preview) div = std::clamp(int(std::ceil(std::sqrt(last_full_ms / 33.0))), 2, 4);
             const int w = std::max(1, req.width / div), h = std::max(1, req.height / div);
             const Clock::time_point start = Clock::now();
             Frame f = renderer.render(req, w, h);
@@ -383,23 +386,24 @@ void Server::Impl::render_loop() {
             info.tf_update_ms = f.tf_update_seconds * 1e3;
             // Received -> ready to render: the wait for the frame in progress, the (possible)
             // structure build and the TF update.
-            info.tf_latency_ms =
-                f.tf_changed ? ms_between(received, start) + f.accel_build_seconds * 1e3 +
-                                   f.tf_update_seconds * 1e3
-                             : 0;
+            info.tf_latency_ms = f.tf_changed
+                                     ? ms_between(received, start) + f.accel_build_seconds * 1e3 +
+                                           f.tf_update_seconds * 1e3
+                                     : 0;
             info.accel_build_ms = f.accel_build_seconds * 1e3;
             info.accel_tf_update_ms = f.accel_tf_update_seconds * 1e3;
             const Clock::time_point e0 = Clock::now();
-            const std::string jpeg = encode_jpeg(
-                f.image, req.preview ? options.preview_quality : options.jpeg_quality);
+            const std::string jpeg =
+                encode_jpeg(f.image, req.preview ? options.preview_quality : options.jpeg_quality);
             info.encode_ms = ms_between(e0, Clock::now());
             message = frame_message(info, jpeg);
             net::post(ioc, [s, m = std::move(message)]() mutable { s->send_frame(std::move(m)); });
         } catch (const std::exception& e) {
             // lacuna::Error (e.g. a structure's options) or out of memory: report, keep serving.
-            net::post(ioc, [s, m = error_message(std::string("render: ") + e.what(), req.id)]() mutable {
-                s->send_text(std::move(m));
-            });
+            net::post(ioc,
+                      [s, m = error_message(std::string("render: ") + e.what(), req.id)]() mutable {
+                          s->send_text(std::move(m));
+                      });
         }
     }
 }
@@ -442,7 +446,8 @@ Server::~Server() {
 uint16_t Server::start() {
     boost::system::error_code ec;
     const auto address = net::ip::make_address(m->options.host, ec);
-    if (ec) throw Error("--host", "address", "expected an IP address, got '" + m->options.host + "'");
+    if (ec)
+        throw Error("--host", "address", "expected an IP address, got '" + m->options.host + "'");
     m->loopback = address.is_loopback();
     const tcp::endpoint ep{address, m->options.port};
     const std::string where = m->options.host + ":" + std::to_string(m->options.port);

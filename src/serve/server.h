@@ -37,7 +37,7 @@ struct ServerOptions {
 };
 
 class Server {
-public:
+  public:
     // The renderer must outlive the server.
     Server(FrameRenderer& renderer, ServerOptions options);
     ~Server();  // stops and joins
@@ -55,7 +55,7 @@ public:
 
     struct Impl;  // opaque: Beast stays out of this header
 
-private:
+  private:
     std::shared_ptr<Impl> m;
 };
 

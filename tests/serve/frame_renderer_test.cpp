@@ -1,5 +1,7 @@
 // The viewer's frames are the CLI's images: same settings, same bytes; every structure gives
 // the `none` image through TF changes and structure switches; the overlay's numbers are exact.
+#include "serve/frame_renderer.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,7 +12,6 @@
 #include "lacuna/error.h"
 #include "lacuna/io.h"
 #include "lacuna/synthetic.h"
-#include "serve/frame_renderer.h"
 #include "serve/jpeg.h"
 
 namespace fs = std::filesystem;
@@ -58,8 +59,7 @@ ViewRequest request(AccelKind accel, const std::string& tf) {
 TEST(FrameRenderer, SameBytesAsTheCliRenderer) {
     for (const bool ert : {false, true}) {
         const fs::path out = temp_dir() / (ert ? "cli_ert.png" : "cli.png");
-        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " +
-                                shells_file().string() +
+        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + shells_file().string() +
                                 " --tf mr-default --accel bitfield --width 40 --height 36"
                                 " --azimuth 40 --elevation 20 --zoom 1.3 --step 0.5 --ert " +
                                 (ert ? "0.99" : "1") + " --out " + out.string() + " >/dev/null";
@@ -125,7 +125,8 @@ TEST(FrameRenderer, ReportsTfChangesBuildsAndSkippedSpace) {
     // The sphere fills a fraction of its box: the structure skips a good part of the lattice.
     EXPECT_GT(f.skipped, 0.2);
     EXPECT_LT(f.skipped, 1.0);
-    EXPECT_NEAR(double(f.stats.samples), double(f.lattice_samples) * (1.0 - f.skipped), 1e-6 * double(f.lattice_samples));
+    EXPECT_NEAR(double(f.stats.samples), double(f.lattice_samples) * (1.0 - f.skipped),
+                1e-6 * double(f.lattice_samples));
 
     req.tf = preset("mr-brain");
     f = fr.render(req, 30, 30);
@@ -158,8 +159,8 @@ TEST(FrameRenderer, HistogramCountsEveryVoxel) {
     for (int k = 0; k < 11; ++k)
         for (int j = 0; j < 13; ++j)
             for (int i = 0; i < 17; ++i) {
-                const double u = (double(v.value(i, j, k)) - r.min) * FrameRenderer::kHistogramBins /
-                                 (double(r.max) - r.min);
+                const double u = (double(v.value(i, j, k)) - r.min) *
+                                 FrameRenderer::kHistogramBins / (double(r.max) - r.min);
                 ++expect[size_t(std::clamp(int(u), 0, FrameRenderer::kHistogramBins - 1))];
             }
     FrameRenderer fr(std::move(v));

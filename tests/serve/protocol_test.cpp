@@ -1,5 +1,7 @@
 // The viewer protocol: a well-formed request parses into typed values; every malformed,
 // oversized or out-of-range message is rejected with a lacuna::Error naming the field.
+#include "serve/protocol.h"
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -7,7 +9,6 @@
 
 #include "lacuna/error.h"
 #include "lacuna/synthetic.h"
-#include "serve/protocol.h"
 
 using nlohmann::json;
 using namespace lacuna;
@@ -88,8 +89,8 @@ TEST(Protocol, RejectsOversizedAndDeeplyNestedMessages) {
     EXPECT_THROW(parse_request(good_request().dump(), small), Error);
     const std::string deep = std::string(100000, '[') + std::string(100000, ']');
     EXPECT_NE(rejection(deep).find("size"), std::string::npos);
-    const std::string nested = "{\"type\":\"render\",\"x\":" + std::string(40, '[') +
-                               std::string(40, ']') + "}";
+    const std::string nested =
+        "{\"type\":\"render\",\"x\":" + std::string(40, '[') + std::string(40, ']') + "}";
     EXPECT_NE(rejection(nested).find("nesting"), std::string::npos);
     // Brackets inside strings are not nesting.
     json named = good_request();
@@ -113,8 +114,8 @@ TEST(Protocol, RejectsUnknownTypesAndKeys) {
 }
 
 TEST(Protocol, RejectsMissingFieldsAndWrongTypes) {
-    for (const char* key : {"id", "width", "height", "preview", "camera", "renderer", "accel",
-                            "ert", "step", "tf"}) {
+    for (const char* key :
+         {"id", "width", "height", "preview", "camera", "renderer", "accel", "ert", "step", "tf"}) {
         json j = good_request();
         j.erase(key);
         expect_rejected(j, std::string(key) + ": missing");

@@ -1,17 +1,17 @@
 // The server on an ephemeral port, driven by real Beast clients: the page and nothing else over
 // HTTP, hello / render / error over the WebSocket, several tabs at once, clean stop.
+#include "serve/server.h"
+
 #include <gtest/gtest.h>
 
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
-
 #include <thread>
 
 #include "lacuna/error.h"
 #include "lacuna/synthetic.h"
-#include "serve/server.h"
 
 namespace beast = boost::beast;
 namespace http = beast::http;
@@ -26,7 +26,7 @@ namespace {
 
 // A server on 127.0.0.1:<ephemeral> serving a small sphere, run on its own thread.
 class Running {
-public:
+  public:
     explicit Running(int max_sessions = 32) {
         SyntheticOptions so;
         so.dims = {20, 18, 16};
@@ -47,7 +47,7 @@ public:
     }
     uint16_t port = 0;
 
-private:
+  private:
     std::unique_ptr<FrameRenderer> m_renderer;
     std::unique_ptr<Server> m_server;
     std::thread m_thread;
