@@ -228,9 +228,12 @@ void run_faludi(FaludiArgs& a) {
 
 }  // namespace
 
+void register_bench_kdtree(CLI::App& bench);  // cmd_bench_kdtree.cpp
+
 void register_bench(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Benchmarks (docs/benchmarks.md)");
     cmd->require_subcommand(1);
+    register_bench_kdtree(*cmd);
 
     auto a = std::make_shared<FaludiArgs>();
     auto* f = cmd->add_subcommand(

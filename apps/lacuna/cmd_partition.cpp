@@ -18,6 +18,7 @@
 
 #include "accel/kdtree_partition.h"
 #include "cli_common.h"
+#include "partition_boxes.h"
 #include "core/parallel.h"
 #include "io/io_util.h"
 #include "lacuna/accel.h"
@@ -44,6 +45,10 @@ struct PartitionArgs {
     float azimuth = 30.f, elevation = 20.f;
     int threads = 0;
     int repeat = 1;
+    // --method boxes (growing-boxes paper): typed options, the picture's slice, merging.
+    BoxesOptions boxes;
+    bool no_merge = false;
+    int slice = -1;
 };
 
 // ---- the overlay: box edges projected through the camera -----------------------------------
@@ -180,8 +185,33 @@ double round6(float x) {
 }
 
 void run(const PartitionArgs& a) {
-    if (a.method == "boxes")
-        throw Error("--method", "method", "not yet implemented: growing boxes (issue 5)");
+    if (a.method == "boxes") {
+        if (a.tf.empty())
+            throw Error("partition", "--tf", "expected a preset name or a .json file");
+        if (!a.json.empty()) check_output_path(a.json, ".json");
+        if (!a.out.empty()) check_output_path(a.out, ".png");
+        if (a.size < 16 || a.size > 8192)
+            throw Error("--size", "image size", "expected 16..8192 pixels");
+        PartitionBoxesArgs b;
+        b.volume_path = a.volume.path;
+        b.tf = a.tf;
+        b.json = a.json;
+        b.out = a.out;
+        b.options = a.boxes;
+        b.options.merge = !a.no_merge;
+        b.options.threads = a.threads;
+        b.slice = a.slice;
+        b.size = a.size;
+        b.azimuth = a.azimuth;
+        b.elevation = a.elevation;
+        b.repeat = a.repeat;
+        validate(b.options);  // before loading anything
+        if (b.repeat < 1 || b.repeat > 1000)
+            throw Error("--repeat", "repeat", "expected 1..1000");
+        resolve_transfer_function(b.tf);
+        run_partition_boxes(b, load_volume(a.volume));
+        return;
+    }
     if (a.method != "kdtree")
         throw Error("--method", "method",
                     "unknown '" + a.method + "'; expected one of: kdtree, boxes");
@@ -331,7 +361,7 @@ void register_partition(CLI::App& app) {
         "partition", "Empty-space partition of a volume as boxes: JSON and an overlay picture");
     add_volume_args(*cmd, a->volume);
     cmd->add_option("--tf", a->tf, "Transfer function: a preset name or a .json file")->required();
-    cmd->add_option("--method", a->method, "Partition method: kdtree (boxes: not yet)")
+    cmd->add_option("--method", a->method, "Partition method: kdtree or boxes")
         ->capture_default_str();
     cmd->add_option("--max-boxes", a->max_boxes, "M: at most this many boxes (0 = every leaf)")
         ->capture_default_str();
@@ -359,6 +389,26 @@ void register_partition(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--repeat", a->repeat,
                     "Run steps 1-4 this many times; report median step times")
+        ->capture_default_str();
+    // --method boxes (docs/growing-boxes.md).
+    cmd->add_option("--spread", a->boxes.spread,
+                    "boxes: uniform box value spread in 256ths of the full scale")
+        ->capture_default_str();
+    cmd->add_option("--min-box", a->boxes.min_uniform, "boxes: smallest uniform box edge, cells")
+        ->capture_default_str();
+    cmd->add_option("--gradient", a->boxes.gradient,
+                    "boxes: gradient cell above this |grad| (full scale per voxel)")
+        ->capture_default_str();
+    cmd->add_option("--gradient-waste", a->boxes.gradient_waste,
+                    "boxes: most non-gradient share of a gradient box")
+        ->capture_default_str();
+    cmd->add_option("--other-cost", a->boxes.other_cost,
+                    "boxes: other box cost bound (volume x spread / full scale, cells)")
+        ->capture_default_str();
+    cmd->add_option("--thin", a->boxes.thin, "boxes: merge rule 3, thinner than this many cells")
+        ->capture_default_str();
+    cmd->add_flag("--no-merge", a->no_merge, "boxes: skip the BSP tree's bottom-up merging");
+    cmd->add_option("--slice", a->slice, "boxes: z cell layer of the picture (-1 = middle)")
         ->capture_default_str();
     cmd->callback([a] { run(*a); });
 }

@@ -11,6 +11,7 @@
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
+#include "segments_cli.h"
 
 namespace lacuna::cli {
 
@@ -42,6 +43,7 @@ struct RenderArgs {
     bool top_down = false;
     std::string background = "0,0,0";
     FeatureArgs features;  // shading, lights, clipping, blend modes (feature_args.h)
+    SegmentArgs segments;
 };
 
 Vec3f parse_rgb(const std::string& s) {
@@ -91,7 +93,8 @@ Setup validate(RenderArgs& a) {
         if (!a.elevation_given) a.elevation = kDemoElevation;
     }
     if (a.volume.path.empty()) throw Error("render", "volume", "expected a volume file (or --demo)");
-    if (a.tf.empty() && a.tf_animate.empty())
+    const bool labels_alone = a.segments.mode == "labels";
+    if (a.tf.empty() && a.tf_animate.empty() && !labels_alone)
         throw Error("render", "--tf", "expected a preset name or a .json file");
     if (a.out.empty()) throw Error("render", "--out", "expected an output .png file");
     check_output_path(a.out, ".png");
@@ -229,7 +232,12 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 
 void run(RenderArgs& a) {
     const Setup s = validate(a);
-    if (a.tf_animate.empty())
+    if (a.segments.active()) {
+        if (!a.tf_animate.empty())
+            throw Error("--tf-animate", "segments", "not available with --labels/--segments");
+        render_segments(a.segments, SegmentFrame{a.volume, a.tf, a.accel, a.leaf, a.bits, s.ro,
+                                                 s.op, s.w, s.h, a.out, a.heatmap});
+    } else if (a.tf_animate.empty())
         render_one(a, s);
     else
         render_animation(a, s);
@@ -279,6 +287,7 @@ void register_render(CLI::App& app) {
     cmd->add_option("--background", a->background, "Background colour R,G,B in [0,1]")
         ->capture_default_str();
     add_feature_args(*cmd, a->features);
+    add_segment_args(*cmd, a->segments);
     cmd->callback([a, cmd] {
         a->azimuth_given = cmd->count("--azimuth") > 0;
         a->elevation_given = cmd->count("--elevation") > 0;

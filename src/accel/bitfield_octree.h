@@ -22,12 +22,15 @@ public:
     BitfieldOctree(const Volume& v, const AccelOptions& o);
     void set_transfer_function(const TransferLut& lut) override;
     Region region(const int cell[3], int& hint) const {
-        return octree_region(m_pyr, cell, hint, m_start, m_opts.bidirectional, [&](size_t i) {
-            const uint64_t* w = &m_bits[i * size_t(m_words)];
-            uint64_t hit = w[0] & m_tf[0];
-            if (m_words == 2) hit |= w[1] & m_tf[1];
-            return hit == 0;
-        });
+        return octree_region(m_pyr, cell, hint, m_start, m_opts.bidirectional,
+                             [&](size_t i) { return empty_node(i); });
+    }
+    // Node i of the pyramid (Pyramid::index) is invisible under the current TF.
+    bool empty_node(size_t i) const {
+        const uint64_t* w = &m_bits[i * size_t(m_words)];
+        uint64_t hit = w[0] & m_tf[0];
+        if (m_words == 2) hit |= w[1] & m_tf[1];
+        return hit == 0;
     }
     using Cursor = RegionCursor<BitfieldOctree>;
     // MIP/MinIP skipping (src/accel/entry_window.h): empty when no cell of the node can produce

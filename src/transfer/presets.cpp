@@ -11,6 +11,7 @@
 
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
+#include "transfer/slicer_presets.h"
 
 namespace lacuna {
 
@@ -173,6 +174,8 @@ TransferFunction preset(const std::string& name) {
 
 TransferFunction resolve_transfer_function(const std::string& spec) {
     if (const PresetEntry* p = find_preset(spec)) return p->make();
+    // 3D Slicer presets: slicer:FILE.xml#NAME, FILE.vp, FILE.vp.json (slicer_presets.h).
+    if (is_slicer_spec(spec)) return to_transfer_function(resolve_slicer_preset(spec));
     std::string lower = spec;
     std::transform(lower.begin(), lower.end(), lower.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
@@ -182,7 +185,7 @@ TransferFunction resolve_transfer_function(const std::string& spec) {
         return load_transfer_function(spec);
     throw Error(
         "--tf", "preset",
-        "unknown preset '" + spec + "'; expected one of: " + joined_names() + " or a .json file");
+        "unknown preset '" + spec + "'; expected one of: " + joined_names() + " or a .json file (or slicer:FILE.xml#NAME, FILE.vp, FILE.vp.json)");
 }
 
 }  // namespace lacuna

@@ -835,14 +835,15 @@ TEST(KdTreePartitionCli, WritesBoxesJsonAndOverlayPng) {
           "\"empty_space_removed_percent\"", "\"boxes\"", "\"classify\""})
         EXPECT_NE(j.find(key), std::string::npos) << key << " missing from " << j;
     EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
-    // Threshold classification works for partition, and the unimplemented method is an error.
+    // Threshold classification works for partition, and an unknown method is an error (boxes:
+    // tests/slice/partition_boxes_cli_test.cpp).
     const CliRun t = run_cli("partition " + vol.string() +
                              " --tf mr-default --threshold 100 --json " + json.string());
     EXPECT_EQ(t.code, 0) << t.err;
     const CliRun b = run_cli("partition " + vol.string() +
-                             " --tf mr-default --method boxes --json " + json.string());
+                             " --tf mr-default --method octree --json " + json.string());
     EXPECT_EQ(b.code, 2);
-    EXPECT_NE(b.err.find("not yet implemented: growing boxes (issue 5)"), std::string::npos)
+    EXPECT_NE(b.err.find("unknown 'octree'; expected one of: kdtree, boxes"), std::string::npos)
         << b.err;
     EXPECT_EQ(b.err.find('\n'), b.err.size() - 1) << b.err;
     const CliRun m = run_cli("partition " + vol.string() +
