@@ -49,5 +49,6 @@ void register_render(CLI::App& app);
 void register_generate(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_partition(CLI::App& app);
+void register_serve(CLI::App& app);
 
 }  // namespace lacuna::cli

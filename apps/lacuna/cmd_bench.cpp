@@ -234,6 +234,8 @@ void register_bench(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Benchmarks (docs/benchmarks.md)");
     cmd->require_subcommand(1);
     register_bench_kdtree(*cmd);
+    void register_bench_li(CLI::App&);  // cmd_bench_li.cpp
+    register_bench_li(*cmd);
 
     auto a = std::make_shared<FaludiArgs>();
     auto* f = cmd->add_subcommand(

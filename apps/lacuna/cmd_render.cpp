@@ -6,6 +6,7 @@
 
 #include "cli_common.h"
 #include "feature_args.h"
+#include "render_slice.h"
 #include "core/parallel.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
@@ -44,6 +45,7 @@ struct RenderArgs {
     std::string background = "0,0,0";
     FeatureArgs features;  // shading, lights, clipping, blend modes (feature_args.h)
     SegmentArgs segments;
+    SliceCliArgs slice;  // --renderer, --occlusion* (render_slice.h)
 };
 
 Vec3f parse_rgb(const std::string& s) {
@@ -232,12 +234,28 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 
 void run(RenderArgs& a) {
     const Setup s = validate(a);
+    check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
+    // Shading, lights, clipping, blend modes and jitter live in the ray marcher's feature kernel.
+    if (s.ro.features.any() || !a.features.tf_back.empty()) {
+        if (a.segments.active())
+            throw Error("--shading/--clip/--blend", "segments", "not available with --labels/--segments");
+        if (a.slice.renderer == "slice")
+            throw Error("--renderer", "slice", "shading, lights, clipping, blend modes and jitter need the ray marcher");
+    }
     if (a.segments.active()) {
         if (!a.tf_animate.empty())
             throw Error("--tf-animate", "segments", "not available with --labels/--segments");
+        if (a.slice.renderer == "slice")
+            throw Error("--renderer", "segments", "segments are rendered by the ray marcher only");
         render_segments(a.segments, SegmentFrame{a.volume, a.tf, a.accel, a.leaf, a.bits, s.ro,
                                                  s.op, s.w, s.h, a.out, a.heatmap});
-    } else if (a.tf_animate.empty())
+        return;
+    }
+    if (a.slice.renderer == "slice") {
+        render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
+        return;
+    }
+    if (a.tf_animate.empty())
         render_one(a, s);
     else
         render_animation(a, s);
@@ -288,7 +306,10 @@ void register_render(CLI::App& app) {
         ->capture_default_str();
     add_feature_args(*cmd, a->features);
     add_segment_args(*cmd, a->segments);
+    add_slice_options(*cmd, a->slice);
     cmd->callback([a, cmd] {
+        a->slice.threshold_given = cmd->count("--occlusion-threshold") > 0;
+        a->slice.map_given = cmd->count("--occlusion-map") > 0;
         a->azimuth_given = cmd->count("--azimuth") > 0;
         a->elevation_given = cmd->count("--elevation") > 0;
         run(*a);

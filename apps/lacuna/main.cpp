@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     lacuna::cli::register_generate(app);
     lacuna::cli::register_bench(app);
     lacuna::cli::register_partition(app);
+    lacuna::cli::register_serve(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

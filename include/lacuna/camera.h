@@ -39,6 +39,10 @@ public:
     int height() const { return m_height; }
     Vec3f eye() const { return m_eye; }
     Vec3f forward() const { return m_forward; }
+    // The screen basis and half height generate() uses (object-order renderers project with it).
+    Vec3f right() const { return m_right; }
+    Vec3f up() const { return m_up; }
+    float half_height() const { return m_half_h; }
     Projection projection() const { return m_projection; }
 
 private:

@@ -1,0 +1,89 @@
+#include "render_slice.h"
+
+#include <cstdio>
+
+#include "core/parallel.h"
+#include "lacuna/error.h"
+#include "lacuna/transfer_function.h"
+#include "slice/box_sources.h"
+#include "slice/slice_renderer.h"
+
+namespace lacuna::cli {
+
+void add_slice_options(CLI::App& cmd, SliceCliArgs& a) {
+    cmd.add_option("--renderer", a.renderer,
+                   "march (ray marcher) or slice (object-order slicer, docs/slicer.md)")
+        ->capture_default_str();
+    cmd.add_flag("--occlusion", a.occlusion,
+                 "Slicer: occlusion culling and clipping against the opacity map");
+    cmd.add_option("--occlusion-threshold", a.occlusion_threshold,
+                   "Slicer: opacity at which the map counts a cell as occluded (1 = exact)")
+        ->capture_default_str();
+    cmd.add_option("--occlusion-map", a.occlusion_map, "Slicer: opacity map edge in cells")
+        ->capture_default_str();
+}
+
+void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap) {
+    if (a.renderer != "march" && a.renderer != "slice")
+        throw Error("--renderer", "renderer", "expected march or slice, got '" + a.renderer + "'");
+    if (a.renderer == "march") {
+        if (a.occlusion || a.threshold_given || a.map_given)
+            throw Error("--occlusion", "renderer",
+                        "occlusion clipping belongs to the slicer: add --renderer slice");
+        return;
+    }
+    if (animate) throw Error("--tf-animate", "renderer", "only with --renderer march");
+    if (heatmap) throw Error("--heatmap", "renderer", "only with --renderer march");
+    if ((a.threshold_given || a.map_given) && !a.occlusion)
+        throw Error("--occlusion-threshold", "occlusion", "needs --occlusion");
+    if (!(a.occlusion_threshold > 0.f && a.occlusion_threshold <= 1.f))
+        throw Error("--occlusion-threshold", "threshold", "expected 0 < T <= 1");
+    if (a.occlusion_map < 1 || a.occlusion_map > 4096)
+        throw Error("--occlusion-map", "map size", "expected 1..4096 cells");
+}
+
+void render_slice(const SliceCliArgs& a, const SliceRenderJob& job) {
+    const TransferFunction tf = resolve_transfer_function(job.tf);
+    const Volume vol = load_volume(job.volume);
+    const TransferLut lut = discretise(tf, vol.vis_range());
+    Progress progress("building " + job.accel);
+    auto source = make_box_source(job.accel, vol, job.accel_options);
+    source->set_transfer_function(lut);
+    progress.done();
+    SliceRenderer slicer(vol);
+    slicer.set_transfer_function(lut);
+    if (job.accel != "none") slicer.set_box_source(source.get());
+    SliceOptions o;
+    o.step = job.render.step;
+    o.ert = job.render.ert;
+    o.threads = job.render.threads;
+    o.background = job.render.background;
+    if (a.occlusion) {
+        o.occlusion.mode = OcclusionMode::CullClip;
+        o.occlusion.threshold = a.occlusion_threshold;
+        o.occlusion.map_size = a.occlusion_map;
+    }
+    const Camera cam = Camera::orbit(slicer.bounds(), job.orbit, job.width, job.height);
+    const SliceResult r = slicer.render(cam, o);
+    write_png(job.out, r.image);
+    const SliceStats& s = r.stats;
+    std::printf("%s: %dx%d %s, tf %s, slice renderer, accel %s, %d threads\n",
+                job.volume.path.c_str(), job.width, job.height,
+                job.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
+                tf.name.c_str(), job.accel.c_str(), resolve_threads(job.render.threads));
+    std::printf("render time %.1f ms (polygon set-up %.1f%%), %llu boxes, %llu polygons, %.1f Msamples/s\n",
+                s.seconds * 1e3, 100 * s.setup_fraction(), (unsigned long long)s.boxes,
+                (unsigned long long)s.polygons, s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0);
+    if (a.occlusion)
+        std::printf("occlusion (threshold %.3g, map %dx%d): %d/%d map updates, %llu boxes culled, "
+                    "%llu clipped, %.1f%% of non-empty voxels skipped (%.1f%% culled, %.1f%% "
+                    "clipped), %.1f ms\n",
+                    a.occlusion_threshold, a.occlusion_map, a.occlusion_map, s.map_updates,
+                    s.desired_updates, (unsigned long long)s.boxes_culled,
+                    (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction(),
+                    100 * s.culled_fraction(), 100 * s.clipped_fraction(),
+                    s.occlusion_seconds * 1e3);
+    std::printf("wrote %s\n", job.out.c_str());
+}
+
+}  // namespace lacuna::cli

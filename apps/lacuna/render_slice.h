@@ -1,0 +1,33 @@
+// `lacuna render --renderer slice`: the object-order slice renderer (docs/slicer.md). Kept out of
+// cmd_render.cpp so the ray-marcher path stays as it was.
+#pragma once
+#include <string>
+
+#include "cli_common.h"
+#include "lacuna/renderer.h"
+
+namespace lacuna::cli {
+
+struct SliceCliArgs {
+    std::string renderer = "march";  // march | slice
+    bool occlusion = false;
+    float occlusion_threshold = 0.95f;
+    int occlusion_map = 64;
+    bool threshold_given = false, map_given = false;
+};
+void add_slice_options(CLI::App& cmd, SliceCliArgs& a);
+// Throws lacuna::Error for an unknown renderer or flags that do not fit it. `animate` and
+// `heatmap`: whether --tf-animate / --heatmap were given (the slicer has neither).
+void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap);
+
+struct SliceRenderJob {
+    VolumeArgs volume;
+    std::string tf, accel, out;
+    AccelOptions accel_options;
+    RenderOptions render;  // step, ert, threads, background
+    OrbitParams orbit;
+    int width = 0, height = 0;
+};
+void render_slice(const SliceCliArgs& a, const SliceRenderJob& job);
+
+}  // namespace lacuna::cli

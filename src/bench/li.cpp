@@ -1,0 +1,253 @@
+#include "bench/li.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "bench/stats.h"
+#include "lacuna/error.h"
+#include "lacuna/renderer.h"
+#include "slice/box_sources.h"
+#include "slice/slice_renderer.h"
+
+namespace lacuna::bench {
+
+namespace {
+
+std::string fmt(const char* f, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+double fps(const LiColumn* c) { return c && c->mean_ms > 0 ? 1e3 / c->mean_ms : 0; }
+double ratio(const LiColumn* a, const LiColumn* b) {
+    return a && b && b->mean_ms > 0 ? a->mean_ms / b->mean_ms : 0;
+}
+
+void finish(LiColumn& c) {
+    c.mean_ms = mean(c.frame_ms);
+    const double n = double(std::max<size_t>(c.frame_ms.size(), 1));
+    c.setup_fraction /= n;
+    c.culled /= n;
+    c.clipped /= n;
+    c.samples /= n;
+}
+
+}  // namespace
+
+const LiColumn* LiDataset::find(const std::string& n) const {
+    for (const LiColumn& c : columns)
+        if (c.name == n) return &c;
+    return nullptr;
+}
+
+LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, const LiLog& log) {
+    LiReport rep;
+    rep.options = o;
+    for (const BenchDataset& ds : datasets) {
+        const Volume& vol = *ds.volume;
+        LiDataset d;
+        d.name = ds.name;
+        d.description = ds.description;
+        d.tf_name = ds.tf_name;
+        d.dims = vol.dims();
+        SliceRenderer slicer(vol);
+        slicer.set_transfer_function(ds.lut);
+        const auto t0 = std::chrono::steady_clock::now();
+        auto source = make_box_source(o.ess, vol, o.accel);
+        source->set_transfer_function(ds.lut);
+        d.source_ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3;
+        const std::vector<Camera> cams = orbit_cameras(slicer.bounds(), o.orbit);
+        if (log) log(ds.name + ": " + o.ess + " boxes built in " + fmt("%.1f", d.source_ms) + " ms");
+
+        Image basic0, ess0, map0, cc0;
+        auto run = [&](const std::string& name, const BoxSource* src, OcclusionMode mode,
+                       bool adaptive, Image* first) {
+            LiColumn col;
+            col.name = name;
+            slicer.set_box_source(src);
+            AdaptiveOptions ao;
+            ao.initial = o.initial_updates;
+            AdaptiveUpdates controller(ao);
+            for (size_t v = 0; v < cams.size(); ++v) {
+                SliceOptions so;
+                so.step = o.step;
+                so.ert = 2.f;  // no per-pixel termination: the paper's GPU has none
+                so.threads = o.threads;
+                so.occlusion.mode = mode;
+                so.occlusion.threshold = o.threshold;
+                so.occlusion.map_size = o.map_size;
+                so.occlusion.updates = o.initial_updates;
+                SliceResult r = slicer.render(cams[v], so, adaptive ? &controller : nullptr);
+                col.frame_ms.push_back(r.stats.seconds * 1e3);
+                col.setup_fraction += r.stats.setup_fraction();
+                col.culled += r.stats.culled_fraction();
+                col.clipped += r.stats.clipped_fraction();
+                col.samples += double(r.stats.samples);
+                if (v == 0 && first) *first = std::move(r.image);
+                if (v == 0 && src) d.boxes = r.stats.boxes;
+                if (v == 0 && src)
+                    d.box_voxels = r.stats.voxels / (double(d.dims.x - 1) * (d.dims.y - 1) * (d.dims.z - 1));
+                if (name == "ESS+CC") {
+                    d.desired_updates.push_back(r.stats.desired_updates);
+                    d.actual_updates.push_back(r.stats.map_updates);
+                }
+            }
+            finish(col);
+            if (log) log("  " + name + ": " + fmt("%.1f", col.mean_ms) + " ms/frame");
+            d.columns.push_back(std::move(col));
+        };
+        run("Basic", nullptr, OcclusionMode::Off, false, &basic0);
+        run("ESS", source.get(), OcclusionMode::Off, false, &ess0);
+        run("ESS+CC", source.get(), OcclusionMode::CullClip, true, &cc0);
+        run("ESS+M", source.get(), OcclusionMode::MapOnly, false, &map0);
+        run("ESS+C", source.get(), OcclusionMode::CullOnly, true, nullptr);
+        d.ess_exact = basic0.rgba == ess0.rgba;
+        d.map_only_exact = map0.rgba == ess0.rgba;
+        for (size_t i = 0; i < cc0.rgba.size() && i < ess0.rgba.size(); ++i)
+            d.max_cc_diff = std::max(d.max_cc_diff, std::abs(int(cc0.rgba[i]) - int(ess0.rgba[i])));
+
+        if (o.march) {
+            RayMarcher m(vol);
+            m.set_transfer_function(ds.lut);
+            RenderOptions ro;
+            ro.step = o.step;
+            ro.ert = 2.f;
+            ro.threads = o.threads;
+            std::vector<std::pair<std::string, std::unique_ptr<Accel>>> accels;
+            accels.push_back({"march none", nullptr});
+            if (o.ess == "kdtree") {
+                auto kd = make_accel(AccelKind::KdTree, vol, o.accel);
+                kd->set_transfer_function(ds.lut);
+                accels.push_back({"march kdtree", std::move(kd)});
+            }
+            for (auto& [name, accel] : accels) {
+                m.set_accel(accel.get());
+                LiColumn col;
+                col.name = name;
+                const OrbitRun run_m = run_orbit(m, cams, ro);
+                for (double s : run_m.frame_seconds) col.frame_ms.push_back(s * 1e3);
+                col.samples = double(run_m.samples);
+                finish(col);
+                col.samples = double(run_m.samples) / double(std::max<size_t>(cams.size(), 1));
+                if (log) log("  " + name + ": " + fmt("%.1f", col.mean_ms) + " ms/frame");
+                d.columns.push_back(std::move(col));
+            }
+        }
+        rep.datasets.push_back(std::move(d));
+    }
+    return rep;
+}
+
+std::string li_markdown(const LiReport& r, const RunInfo& info) {
+    const LiOptions& o = r.options;
+    std::string out = "# lacuna bench li: Tables 1 and 2 of Li, Mueller & Kaufman (2003) on our data\n\n";
+    out += run_info_markdown(info);
+    out += "- Settings: " + std::to_string(o.orbit.size) + "×" + std::to_string(o.orbit.size) +
+           " pixels, " + std::to_string(o.orbit.views) + " views (azimuth 360°·i/" +
+           std::to_string(o.orbit.views) + ", elevation " + fmt("%g", o.orbit.elevation_deg) +
+           "°, perspective), slice distance " + fmt("%g", o.step) +
+           " voxel, no early termination (as the paper's GPU), ESS box source `" + o.ess +
+           "`, occlusion threshold " + fmt("%g", o.threshold) + ", map " +
+           std::to_string(o.map_size) + "², adaptive updates from k = " +
+           std::to_string(o.initial_updates) + " (ESS+CC, ESS+C; ESS+M uses k fixed), threads " +
+           (o.threads > 0 ? std::to_string(o.threads) : "all") + ".\n\n";
+
+    out += "## Table 1: empty space skipping (frames per second)\n\n";
+    out += "| dataset | size | boxes | Basic | ESS | speedup | polygon set-up (ESS) | ESS == Basic |\n";
+    out += "|---|---|---:|---:|---:|---:|---:|---|\n";
+    double sum_ess = 0;
+    for (const LiDataset& d : r.datasets) {
+        const LiColumn *b = d.find("Basic"), *e = d.find("ESS");
+        const double s = ratio(b, e);
+        sum_ess += s;
+        out += "| " + d.name + " | " + std::to_string(d.dims.x) + "×" + std::to_string(d.dims.y) +
+               "×" + std::to_string(d.dims.z) + " | " + std::to_string(d.boxes) + " | " +
+               fmt("%.2f", fps(b)) + " | " + fmt("%.2f", fps(e)) + " | " + fmt("%.2f", s) +
+               " | " + fmt("%.1f%%", 100 * (e ? e->setup_fraction : 0)) + " | " +
+               (d.ess_exact ? "yes" : "**NO**") + " |\n";
+    }
+    if (!r.datasets.empty())
+        out += "| average | | | | | " + fmt("%.2f", sum_ess / double(r.datasets.size())) + " | | |\n";
+
+    out += "\n## Table 2: occlusion clipping\n\n";
+    out += "| dataset | Basic | ESS | ESS+CC | ESS+M | ESS+C | culled % | clipped % | total % | "
+           "speedup ESS | CC | ESS+CC |\n";
+    out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    double a_cul = 0, a_clip = 0, a_ess = 0, a_cc = 0, a_both = 0;
+    for (const LiDataset& d : r.datasets) {
+        const LiColumn *b = d.find("Basic"), *e = d.find("ESS"), *cc = d.find("ESS+CC"),
+                       *m = d.find("ESS+M"), *c = d.find("ESS+C");
+        const double s_ess = ratio(b, e), s_cc = ratio(e, cc), s_both = ratio(b, cc);
+        a_cul += cc->culled;
+        a_clip += cc->clipped;
+        a_ess += s_ess;
+        a_cc += s_cc;
+        a_both += s_both;
+        out += "| " + d.name + " | " + fmt("%.2f", fps(b)) + " | " + fmt("%.2f", fps(e)) + " | " +
+               fmt("%.2f", fps(cc)) + " | " + fmt("%.2f", fps(m)) + " | " + fmt("%.2f", fps(c)) +
+               " | " + fmt("%.1f", 100 * cc->culled) + " | " + fmt("%.1f", 100 * cc->clipped) +
+               " | " + fmt("%.1f", 100 * (cc->culled + cc->clipped)) + " | " +
+               fmt("%.2f", s_ess) + " | " + fmt("%.2f", s_cc) + " | " + fmt("%.2f", s_both) + " |\n";
+    }
+    if (!r.datasets.empty()) {
+        const double n = double(r.datasets.size());
+        out += "| average | | | | | | " + fmt("%.1f", 100 * a_cul / n) + " | " +
+               fmt("%.1f", 100 * a_clip / n) + " | " + fmt("%.1f", 100 * (a_cul + a_clip) / n) +
+               " | " + fmt("%.2f", a_ess / n) + " | " + fmt("%.2f", a_cc / n) + " | " +
+               fmt("%.2f", a_both / n) + " |\n";
+    }
+    out += "\nFrames per second = 1000 / mean frame time over the orbit. Culled / clipped = share "
+           "of the non-empty voxels (cells in the ESS boxes) skipped, mean over the orbit "
+           "(ESS+CC). Speedups: ESS = Basic/ESS, CC = ESS/(ESS+CC), ESS+CC = Basic/(ESS+CC), "
+           "all from this run.\n\n";
+
+    out += "## Details\n\n";
+    out += "| dataset | TF | source build [ms] | box voxels % | Basic [ms] | ESS [ms] | ESS+CC [ms] | "
+           "ESS+M [ms] | ESS+C [ms] | march none [ms] | march ESS [ms] | ESS+M == ESS | max "
+           "|ESS+CC − ESS| (8 bit) | map updates desired/actual (mean) |\n";
+    out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|\n";
+    for (const LiDataset& d : r.datasets) {
+        auto ms = [&](const char* n) {
+            const LiColumn* c = d.find(n);
+            return c ? fmt("%.1f", c->mean_ms) : std::string("–");
+        };
+        double des = 0, act = 0;
+        for (size_t i = 0; i < d.desired_updates.size(); ++i) {
+            des += d.desired_updates[i];
+            act += d.actual_updates[i];
+        }
+        const double n = double(std::max<size_t>(d.desired_updates.size(), 1));
+        out += "| " + d.name + " | " + d.tf_name + " | " + fmt("%.1f", d.source_ms) + " | " +
+               fmt("%.1f", 100 * d.box_voxels) + " | " + ms("Basic") + " | " + ms("ESS") + " | " +
+               ms("ESS+CC") + " | " + ms("ESS+M") + " | " + ms("ESS+C") + " | " +
+               ms("march none") + " | " + ms(("march " + o.ess).c_str()) + " | " +
+               (d.map_only_exact ? "yes" : "**NO**") + " | " + std::to_string(d.max_cc_diff) +
+               " | " + fmt("%.1f", des / n) + " / " + fmt("%.1f", act / n) + " |\n";
+    }
+    out += "\nThe bound for ESS+CC at threshold T is 1 − T of full scale per channel (" +
+           fmt("%.1f", 255.0 * (1.0 - o.threshold)) + " levels, plus rounding).\n";
+    return out;
+}
+
+std::string li_csv(const LiReport& r) {
+    std::string out = "dataset,column,mean_ms,fps,setup_fraction,culled,clipped,samples_per_frame\n";
+    for (const LiDataset& d : r.datasets)
+        for (const LiColumn& c : d.columns)
+            out += d.name + "," + c.name + "," + fmt("%.3f", c.mean_ms) + "," + fmt("%.3f", fps(&c)) +
+                   "," + fmt("%.4f", c.setup_fraction) + "," + fmt("%.4f", c.culled) + "," +
+                   fmt("%.4f", c.clipped) + "," + fmt("%.0f", c.samples) + "\n";
+    return out;
+}
+
+std::string li_updates_csv(const LiReport& r) {
+    std::string out = "dataset,frame,desired_updates,actual_updates\n";
+    for (const LiDataset& d : r.datasets)
+        for (size_t i = 0; i < d.desired_updates.size(); ++i)
+            out += d.name + "," + std::to_string(i) + "," + std::to_string(d.desired_updates[i]) +
+                   "," + std::to_string(d.actual_updates[i]) + "\n";
+    return out;
+}
+
+}  // namespace lacuna::bench

@@ -1,0 +1,158 @@
+#include "serve/frame_renderer.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+#include "core/parallel.h"
+#include "render/ray_march_kernel.h"
+
+namespace lacuna::serve {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::vector<uint64_t> compute_histogram(const Volume& v, int bins, int threads) {
+    std::vector<uint64_t> total(size_t(bins), 0);
+    const ValueRange r = v.vis_range();
+    const double scale = r.max > r.min ? double(bins) / (double(r.max) - double(r.min)) : 0.0;
+    std::mutex merge;
+    visit_voxels(v, [&](const auto* data) {
+        parallel_for(v.voxel_count(), threads, [&](size_t b, size_t e) {
+            std::vector<uint64_t> local(size_t(bins), 0);
+            for (size_t i = b; i < e; ++i) {
+                const double u = (double(data[i]) - double(r.min)) * scale;
+                const int bin = u < 0 ? 0 : (u >= bins ? bins - 1 : int(u));
+                ++local[size_t(bin)];
+            }
+            std::lock_guard<std::mutex> lock(merge);
+            for (int i = 0; i < bins; ++i) total[size_t(i)] += local[size_t(i)];
+        }, size_t(1) << 20);
+    });
+    return total;
+}
+
+// Lattice samples of the reference march (no skipping, no early termination) for every pixel:
+// the same ray set-up and count as render/ray_marcher.cpp, without touching the volume.
+uint64_t lattice_samples(const Volume& vol, const Camera& cam, float step, int threads) {
+    const Vec3i d = vol.dims();
+    const Vec3f inv_sp{float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y),
+                       float(1.0 / vol.spacing.z)};
+    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
+    const float dt = step * min_sp;
+    const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
+    std::atomic<uint64_t> total{0};
+    parallel_for_tiles(cam.width(), cam.height(), 32, threads, [&](int x0, int y0, int x1, int y1) {
+        uint64_t n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const Ray wr = cam.generate(float(x), float(y));
+                const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
+                const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+                float t0, t1;
+                if (kernel::intersect_box(r, hi, t0, t1))
+                    n += uint64_t(std::max(int(std::ceil((t1 - t0) / dt - 0.5f)), 0));
+            }
+        total += n;
+    });
+    return total.load();
+}
+
+}  // namespace
+
+FrameRenderer::FrameRenderer(Volume volume, const AccelOptions& accel_options, int threads)
+    : m_volume(std::make_unique<Volume>(std::move(volume))),
+      m_accel_options(accel_options),
+      m_threads(threads) {
+    m_accel_options.threads = threads;
+    m_histogram = compute_histogram(*m_volume, kHistogramBins, threads);
+    m_marcher = std::make_unique<RayMarcher>(*m_volume);
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+Camera FrameRenderer::camera(const ViewCamera& c, int width, int height) const {
+    OrbitParams op;
+    op.azimuth_deg = c.azimuth;
+    op.elevation_deg = c.elevation;
+    op.zoom = c.zoom;
+    const Box3f bounds = m_marcher->bounds();
+    if (c.pan_x != 0.f || c.pan_y != 0.f) {
+        // Pan moves the orbit's target along the view plane (the camera's right and up, as
+        // Camera::orbit derives them), in units of the bounding sphere's radius.
+        const Camera base = Camera::orbit(bounds, op, width, height);
+        const Vec3f f = base.forward();
+        Vec3f world_up{0, 0, 1};
+        if (std::abs(dot(world_up, f)) > 0.999f) world_up = {0, 1, 0};
+        const Vec3f right = normalize(cross(f, world_up));
+        const Vec3f up = cross(right, f);
+        const float radius = 0.5f * length(bounds.extent());
+        op.has_target = true;
+        op.target = bounds.center() + right * (c.pan_x * radius) + up * (c.pan_y * radius);
+    }
+    return Camera::orbit(bounds, op, width, height);
+}
+
+RenderOptions FrameRenderer::render_options(const ViewRequest& req) const {
+    RenderOptions ro;
+    ro.step = req.step;
+    ro.ert = req.ert ? 0.99f : 2.f;  // as `lacuna render --ert 1`: opacity never reaches 2
+    ro.threads = m_threads;
+    return ro;
+}
+
+Accel& FrameRenderer::accel(AccelKind k, double& build_seconds) {
+    Built& b = m_accels[k];
+    if (!b.accel) {
+        const auto t0 = Clock::now();
+        b.accel = make_accel(k, *m_volume, m_accel_options);
+        build_seconds = seconds_since(t0);
+        b.tf_version = 0;  // holds no TF yet
+    }
+    return *b.accel;
+}
+
+Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
+    Frame f;
+    // 1. A new TF: discretise it and hand it to the marcher and the current structure (the
+    //    "TF change -> ready to render" time of the bitfield paper, Section 4.5).
+    Accel& a = accel(req.accel, f.accel_build_seconds);
+    Built& built = m_accels[req.accel];
+    const auto t0 = Clock::now();
+    if (!m_has_tf || !(req.tf == m_tf)) {
+        m_tf = req.tf;
+        m_has_tf = true;
+        ++m_tf_version;
+        m_lut = discretise(m_tf, m_volume->vis_range());
+        m_marcher->set_transfer_function(m_lut);
+        f.tf_changed = true;
+    }
+    // 2. A structure that missed TF changes (it was not selected then) catches up.
+    if (built.tf_version != m_tf_version) {
+        a.set_transfer_function(m_lut);
+        built.tf_version = m_tf_version;
+    }
+    if (f.tf_changed) f.tf_update_seconds = seconds_since(t0);
+    f.accel_tf_update_seconds = a.stats().tf_update_seconds;
+    m_marcher->set_accel(&a);
+
+    // 3. The frame, and the reference lattice count for the "space skipped" figure.
+    const Camera cam = camera(req.camera, width, height);
+    const RenderOptions ro = render_options(req);
+    RenderResult r = m_marcher->render(cam, ro);
+    f.image = std::move(r.image);
+    f.stats = r.stats;
+    f.lattice_samples = lattice_samples(*m_volume, cam, ro.step, m_threads);
+    f.skipped = f.lattice_samples
+                    ? 1.0 - double(f.stats.samples) / double(f.lattice_samples)
+                    : 0.0;
+    return f;
+}
+
+}  // namespace lacuna::serve

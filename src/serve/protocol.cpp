@@ -1,0 +1,242 @@
+#include "serve/protocol.h"
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "lacuna/error.h"
+
+namespace lacuna::serve {
+
+namespace {
+
+using nlohmann::json;
+
+constexpr int kMaxDepth = 16;  // the deepest a valid request nests is 4
+
+[[noreturn]] void reject(const std::string& field, const std::string& what) {
+    throw Error("message", field, what);
+}
+
+// Rejects over-long or over-deep text before the JSON parser sees it (a deep document would
+// otherwise cost stack and time for nothing).
+void check_shape(std::string_view text, const Limits& limits) {
+    if (text.size() > limits.max_message_bytes)
+        reject("size", std::to_string(text.size()) + " bytes; expected at most " +
+                           std::to_string(limits.max_message_bytes));
+    int depth = 0;
+    bool in_string = false, escaped = false;
+    for (char c : text) {
+        if (in_string) {
+            if (escaped) escaped = false;
+            else if (c == '\\') escaped = true;
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '{' || c == '[') {
+            if (++depth > kMaxDepth) reject("nesting", "deeper than " + std::to_string(kMaxDepth));
+        } else if (c == '}' || c == ']') {
+            --depth;
+        }
+    }
+}
+
+json parse_json(std::string_view text, const Limits& limits) {
+    check_shape(text, limits);
+    json j = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) reject("json", "not valid JSON");
+    if (!j.is_object()) reject("json", "expected an object");
+    return j;
+}
+
+// Every key of `j` must be in `known` (comma-separated list for the message).
+void only_keys(const json& j, std::initializer_list<const char*> known, const std::string& where) {
+    for (const auto& [key, value] : j.items()) {
+        bool ok = false;
+        for (const char* k : known) ok = ok || key == k;
+        if (!ok) {
+            std::string list;
+            for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+            reject(where + key, "unknown key; expected one of: " + list);
+        }
+    }
+}
+
+const json& need(const json& j, const char* key, const std::string& where) {
+    auto it = j.find(key);
+    if (it == j.end()) reject(where + key, "missing");
+    return *it;
+}
+
+double number(const json& j, const char* key, double lo, double hi, const std::string& where) {
+    const json& v = need(j, key, where);
+    if (!v.is_number()) reject(where + key, "expected a number");
+    const double x = v.get<double>();
+    if (!std::isfinite(x) || x < lo || x > hi)
+        reject(where + key, "expected a number in [" + json(lo).dump() + ", " + json(hi).dump() +
+                                "], got " + v.dump());
+    return x;
+}
+
+int integer(const json& j, const char* key, int lo, int hi, const std::string& where) {
+    const json& v = need(j, key, where);
+    if (!v.is_number_integer() || v.get<int64_t>() < lo || v.get<int64_t>() > hi)
+        reject(where + key, "expected an integer in [" + std::to_string(lo) + ", " +
+                                std::to_string(hi) + "], got " + v.dump());
+    return int(v.get<int64_t>());
+}
+
+bool boolean(const json& j, const char* key, const std::string& where) {
+    const json& v = need(j, key, where);
+    if (!v.is_boolean()) reject(where + key, "expected true or false");
+    return v.get<bool>();
+}
+
+std::string text_of(const json& j, const char* key, const std::string& where) {
+    const json& v = need(j, key, where);
+    if (!v.is_string()) reject(where + key, "expected a string");
+    return v.get<std::string>();
+}
+
+uint64_t id_of(const json& j) {
+    const json& v = need(j, "id", "");
+    // Integers up to 2^53 survive a JavaScript number.
+    if (!v.is_number_unsigned() || v.get<uint64_t>() > (uint64_t(1) << 53))
+        reject("id", "expected an integer in [0, 2^53]");
+    return v.get<uint64_t>();
+}
+
+}  // namespace
+
+std::string to_string(RendererKind k) {
+    switch (k) {
+        case RendererKind::March: return "march";
+    }
+    return "?";
+}
+
+std::vector<std::string> renderer_names() { return {"march"}; }
+
+ViewRequest parse_request(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    const std::string type = text_of(j, "type", "");
+    if (type != "render") reject("type", "unknown message type '" + type + "'; expected render");
+    only_keys(j, {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
+                  "step", "tf"},
+              "");
+    ViewRequest r;
+    r.id = id_of(j);
+    r.width = integer(j, "width", 1, limits.max_side, "");
+    r.height = integer(j, "height", 1, limits.max_side, "");
+    r.preview = boolean(j, "preview", "");
+    const json& cam = need(j, "camera", "");
+    if (!cam.is_object()) reject("camera", "expected an object");
+    only_keys(cam, {"azimuth", "elevation", "zoom", "pan"}, "camera.");
+    r.camera.azimuth = float(number(cam, "azimuth", -1e6, 1e6, "camera."));
+    r.camera.elevation = float(number(cam, "elevation", -89.9, 89.9, "camera."));
+    r.camera.zoom = float(number(cam, "zoom", 0.05, 50, "camera."));
+    const json& pan = need(cam, "pan", "camera.");
+    if (!pan.is_array() || pan.size() != 2 || !pan[0].is_number() || !pan[1].is_number())
+        reject("camera.pan", "expected [x, y]");
+    const double px = pan[0].get<double>(), py = pan[1].get<double>();
+    if (!std::isfinite(px) || !std::isfinite(py) || std::abs(px) > 100 || std::abs(py) > 100)
+        reject("camera.pan", "expected numbers in [-100, 100]");
+    r.camera.pan_x = float(px);
+    r.camera.pan_y = float(py);
+
+    const std::string renderer = text_of(j, "renderer", "");
+    bool found = false;
+    for (const auto& n : renderer_names()) found = found || n == renderer;
+    if (!found) reject("renderer", "unknown '" + renderer + "'; expected march");
+    r.renderer = RendererKind::March;
+    try {
+        r.accel = parse_accel(text_of(j, "accel", ""));
+    } catch (const Error& e) {
+        reject("accel", e.what());
+    }
+    r.ert = boolean(j, "ert", "");
+    r.step = float(number(j, "step", 0.1, 8, ""));
+
+    const json& tf = need(j, "tf", "");
+    if (!tf.is_object()) reject("tf", "expected a transfer-function object");
+    size_t points = 0;
+    for (const char* key : {"color", "opacity"})
+        if (auto it = tf.find(key); it != tf.end() && it->is_array()) points += it->size();
+    if (points > size_t(limits.max_tf_points))
+        reject("tf", std::to_string(points) + " points; expected at most " +
+                         std::to_string(limits.max_tf_points));
+    // The library's own reader validates the TF (shape, ranges, sorting) and throws
+    // lacuna::Error naming the field.
+    r.tf = parse_transfer_function(tf.dump(), "tf");
+    return r;
+}
+
+std::optional<uint64_t> request_id(std::string_view text, const Limits& limits) {
+    try {
+        return id_of(parse_json(text, limits));
+    } catch (const Error&) {
+        return std::nullopt;
+    }
+}
+
+std::string hello_message(const HelloInfo& h) {
+    json j;
+    j["type"] = "hello";
+    j["version"] = kProtocolVersion;
+    const Volume& v = *h.volume;
+    j["volume"] = {{"name", h.volume_name},
+                   {"dims", {v.dims().x, v.dims().y, v.dims().z}},
+                   {"type", to_string(v.type())},
+                   {"spacing", {v.spacing.x, v.spacing.y, v.spacing.z}},
+                   {"data_range", {v.data_range().min, v.data_range().max}},
+                   {"vis_range", {v.vis_range().min, v.vis_range().max}}};
+    j["histogram"] = h.histogram;
+    json presets = json::object();
+    for (const auto& name : preset_names()) presets[name] = json::parse(to_json(preset(name)));
+    j["presets"] = presets;
+    j["tf"] = json::parse(to_json(h.initial_tf));
+    j["accels"] = h.accels;
+    j["renderers"] = h.renderers;
+    j["limits"] = {{"max_message_bytes", h.limits.max_message_bytes},
+                   {"max_side", h.limits.max_side},
+                   {"max_tf_points", h.limits.max_tf_points}};
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string frame_header(const FrameInfo& f) {
+    json j{{"type", "frame"},
+           {"id", f.id},
+           {"width", f.width},
+           {"height", f.height},
+           {"preview", f.preview},
+           {"renderer", f.renderer},
+           {"accel", f.accel},
+           {"frame_ms", f.frame_ms},
+           {"encode_ms", f.encode_ms},
+           {"samples_per_ray", f.samples_per_ray},
+           {"skipped", f.skipped},
+           {"tf_changed", f.tf_changed},
+           {"tf_update_ms", f.tf_update_ms},
+           {"tf_latency_ms", f.tf_latency_ms},
+           {"accel_build_ms", f.accel_build_ms},
+           {"accel_tf_update_ms", f.accel_tf_update_ms}};
+    return j.dump();
+}
+
+std::string frame_message(const FrameInfo& f, std::string_view jpeg) {
+    const std::string header = frame_header(f);
+    std::string out(4, '\0');
+    const uint32_t n = uint32_t(header.size());
+    for (int b = 0; b < 4; ++b) out[size_t(b)] = char((n >> (8 * b)) & 0xff);
+    out += header;
+    out.append(jpeg.data(), jpeg.size());
+    return out;
+}
+
+std::string error_message(const std::string& message, std::optional<uint64_t> id) {
+    json j{{"type", "error"}, {"message", message}};
+    j["id"] = id ? json(*id) : json(nullptr);
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+}  // namespace lacuna::serve

@@ -1,0 +1,101 @@
+// The viewer's WebSocket protocol (docs/viewer.md): JSON text messages from the page, JSON text
+// and binary frame messages from the server. Strings become typed values here (STYLE.md 3):
+// below this file the server sees only ViewRequest.
+//
+// Page -> server (text, one JSON object, at most Limits::max_message_bytes):
+//   {"type":"render", "id":N, "width":W, "height":H, "preview":bool,
+//    "camera":{"azimuth":deg, "elevation":deg, "zoom":f, "pan":[x,y]},
+//    "renderer":"march", "accel":"bitfield", "ert":bool, "step":f,
+//    "tf":{...the transfer-function JSON of docs/transfer-functions.md...}}
+//   Every request carries the whole view state, so the server can drop all but the latest.
+//   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
+//   with an "error" message naming the field; the connection stays open.
+// Server -> page:
+//   text   {"type":"hello", ...}    once, on connect: volume, histogram, presets, accels,
+//                                    renderers, limits
+//   text   {"type":"error", "id":N|null, "message":"..."}
+//   binary [u32 little-endian n][n bytes of JSON header {"type":"frame", ...}][JPEG bytes]
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lacuna/accel.h"
+#include "lacuna/transfer_function.h"
+#include "lacuna/volume.h"
+
+namespace lacuna::serve {
+
+inline constexpr int kProtocolVersion = 1;
+
+// Renderers the viewer can drive. The slicer joins this list when it lands.
+enum class RendererKind { March };
+std::string to_string(RendererKind k);
+std::vector<std::string> renderer_names();
+
+struct Limits {
+    size_t max_message_bytes = 64 * 1024;  // a WebSocket message from the page
+    int max_side = 4096;                   // requested image width/height
+    int max_tf_points = 512;               // colour + opacity points of one TF
+};
+
+struct ViewCamera {
+    float azimuth = 30.f, elevation = 15.f;  // degrees
+    float zoom = 1.f;                        // (0.05, 50]
+    float pan_x = 0.f, pan_y = 0.f;          // along the view's right/up, in bounding radii
+    friend bool operator==(const ViewCamera&, const ViewCamera&) = default;
+};
+
+struct ViewRequest {
+    uint64_t id = 0;
+    int width = 0, height = 0;
+    bool preview = false;  // the page is interacting: render at reduced resolution
+    ViewCamera camera;
+    RendererKind renderer = RendererKind::March;
+    AccelKind accel = AccelKind::None;
+    bool ert = true;     // early ray termination at 0.99 (false: off)
+    float step = 0.5f;   // sample distance in smallest voxel spacings, [0.1, 8]
+    TransferFunction tf;
+};
+
+// Parses one message from the page. Throws lacuna::Error("message", field, expectation) for
+// anything malformed, oversized or out of range; never anything else.
+ViewRequest parse_request(std::string_view text, const Limits& limits = {});
+// Best effort: the "id" of a rejected message, to echo in the error (nullopt if none).
+std::optional<uint64_t> request_id(std::string_view text, const Limits& limits = {});
+
+struct HelloInfo {
+    std::string volume_name;
+    const Volume* volume = nullptr;
+    std::vector<uint64_t> histogram;  // bins over the visualization range
+    TransferFunction initial_tf;       // the TF the page starts with
+    std::vector<std::string> accels, renderers;
+    Limits limits;
+};
+std::string hello_message(const HelloInfo& h);
+
+// What the page shows in its overlay, sent with every frame.
+struct FrameInfo {
+    uint64_t id = 0;
+    int width = 0, height = 0;  // of the JPEG (reduced when preview)
+    bool preview = false;
+    std::string renderer, accel;
+    double frame_ms = 0;        // the render alone
+    double encode_ms = 0;       // JPEG
+    double samples_per_ray = 0;
+    double skipped = 0;         // fraction of the box's lattice samples not taken
+    bool tf_changed = false;    // this frame applied a new TF
+    double tf_update_ms = 0;    // TF change -> ready to render (LUT + structure update)
+    double tf_latency_ms = 0;   // TF message received -> ready to render (includes waiting)
+    double accel_build_ms = 0;  // when this frame built the structure first
+    double accel_tf_update_ms = 0;  // the structure's own last TF update (AccelStats)
+};
+std::string frame_header(const FrameInfo& f);
+// [u32 LE header length][header][jpeg]
+std::string frame_message(const FrameInfo& f, std::string_view jpeg);
+
+std::string error_message(const std::string& message, std::optional<uint64_t> id);
+
+}  // namespace lacuna::serve

@@ -1,0 +1,486 @@
+// The server's threads and protocol plumbing (see server.h). The network side follows Beast's
+// "advanced server" example shape: an HTTP session per connection that either answers from the
+// embedded asset table or upgrades to a WebSocket session.
+//
+// This file is glue, not an algorithm: it owns the two threads the server needs (network and
+// render) directly; the rendering itself is parallelised only through core/parallel.h.
+#include "serve/server.h"
+
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <thread>
+
+#include "lacuna/error.h"
+#include "serve/assets.h"
+#include "serve/jpeg.h"
+
+namespace lacuna::serve {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// "host:port" -> "host" ("[::1]:80" -> "::1").
+std::string host_name(std::string_view host_header) {
+    std::string h(host_header);
+    if (!h.empty() && h.front() == '[') {
+        const size_t close = h.find(']');
+        return close == std::string::npos ? h : h.substr(1, close - 1);
+    }
+    const size_t colon = h.find(':');
+    return colon == std::string::npos ? h : h.substr(0, colon);
+}
+
+bool is_loopback_name(const std::string& h) {
+    if (h == "localhost") return true;
+    boost::system::error_code ec;
+    const auto a = net::ip::make_address(h, ec);
+    return !ec && a.is_loopback();
+}
+
+}  // namespace
+
+class WsSession;
+
+struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
+    Impl(FrameRenderer& r, ServerOptions o) : renderer(r), options(std::move(o)) {}
+
+    FrameRenderer& renderer;
+    ServerOptions options;
+    net::io_context ioc{1};
+    tcp::acceptor acceptor{ioc};
+    std::optional<net::signal_set> signals;
+    std::string hello;
+    bool loopback = true;
+    uint16_t port = 0;
+
+    // Network thread only.
+    std::set<std::shared_ptr<WsSession>> sessions;
+    bool stopping = false;
+
+    // The render thread and its latest-wins slots (guarded by slot_mutex).
+    std::mutex slot_mutex;
+    std::condition_variable slot_cv;
+    std::deque<std::weak_ptr<WsSession>> ready;  // sessions with a pending request, FIFO
+    bool render_stop = false;
+    std::thread render_thread;
+    double last_full_ms = 0;  // render thread only: drives the preview's reduction
+
+    std::once_flag stop_once;
+
+    void accept();
+    void on_accept(beast::error_code ec, tcp::socket socket);
+    void submit(const std::shared_ptr<WsSession>& s);
+    void render_loop();
+    void close_all();
+};
+
+// One browser tab's WebSocket. Every member except the slot is touched only on the network
+// thread.
+class WsSession : public std::enable_shared_from_this<WsSession> {
+public:
+    WsSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
+        : m_ws(std::move(socket)), m_server(std::move(server)) {}
+
+    template <class Body, class Allocator>
+    void run(http::request<Body, http::basic_fields<Allocator>> req) {
+        m_ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+        m_ws.read_message_max(m_server->options.max_frame_bytes);
+        m_ws.async_accept(req, beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
+    }
+
+    // Queues a text message (hello, errors): these are never dropped.
+    void send_text(std::string text) {
+        m_texts.push_back(std::move(text));
+        pump();
+    }
+    // Queues a frame, replacing one that has not started going out (it is stale).
+    void send_frame(std::string frame) {
+        m_frame = std::move(frame);
+        pump();
+    }
+    void close() {
+        beast::error_code ec;
+        beast::get_lowest_layer(m_ws).socket().shutdown(tcp::socket::shutdown_both, ec);
+        beast::get_lowest_layer(m_ws).socket().close(ec);
+    }
+
+    // The latest-wins slot, shared with the render thread (Impl::slot_mutex).
+    std::optional<ViewRequest> pending;
+    Clock::time_point pending_received;
+    bool in_ready = false;
+
+private:
+    void on_accept(beast::error_code ec) {
+        if (ec) return;
+        if (m_server->stopping) return close();
+        m_server->sessions.insert(shared_from_this());
+        if (m_server->options.log)
+            std::printf("viewer: tab connected (%zu open)\n", m_server->sessions.size());
+        send_text(m_server->hello);
+        read();
+    }
+
+    void read() {
+        m_ws.async_read(m_buffer, beast::bind_front_handler(&WsSession::on_read, shared_from_this()));
+    }
+
+    void on_read(beast::error_code ec, size_t) {
+        if (ec) return finish();
+        const std::string text = beast::buffers_to_string(m_buffer.data());
+        m_buffer.consume(m_buffer.size());
+        if (!m_ws.got_text()) {
+            send_text(error_message("message: binary: expected a JSON text message", std::nullopt));
+        } else {
+            try {
+                ViewRequest req = parse_request(text, m_server->options.limits);
+                {
+                    std::lock_guard<std::mutex> lock(m_server->slot_mutex);
+                    pending = std::move(req);  // latest wins: an unrendered request is dropped
+                    pending_received = Clock::now();
+                }
+                m_server->submit(shared_from_this());
+            } catch (const Error& e) {
+                send_text(error_message(e.what(), request_id(text, m_server->options.limits)));
+            }
+        }
+        read();
+    }
+
+    void finish() {
+        if (m_server->sessions.erase(shared_from_this()) && m_server->options.log)
+            std::printf("viewer: tab closed (%zu open)\n", m_server->sessions.size());
+    }
+
+    void pump() {
+        if (m_writing) return;
+        if (!m_texts.empty()) {
+            m_out = std::move(m_texts.front());
+            m_texts.pop_front();
+            m_ws.text(true);
+        } else if (m_frame) {
+            m_out = std::move(*m_frame);
+            m_frame.reset();
+            m_ws.binary(true);
+        } else {
+            return;
+        }
+        m_writing = true;
+        m_ws.async_write(net::buffer(m_out),
+                         beast::bind_front_handler(&WsSession::on_write, shared_from_this()));
+    }
+
+    void on_write(beast::error_code ec, size_t) {
+        m_writing = false;
+        if (ec) return finish();
+        pump();
+    }
+
+    websocket::stream<beast::tcp_stream> m_ws;
+    std::shared_ptr<Server::Impl> m_server;
+    beast::flat_buffer m_buffer;
+    std::deque<std::string> m_texts;
+    std::optional<std::string> m_frame;
+    std::string m_out;  // the message being written (alive until on_write)
+    bool m_writing = false;
+};
+
+// One HTTP connection: GET/HEAD of an embedded asset, or the upgrade to /ws.
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+public:
+    HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
+        : m_stream(std::move(socket)), m_server(std::move(server)) {}
+
+    void run() { read(); }
+
+private:
+    void read() {
+        m_parser.emplace();
+        m_parser->header_limit(8 * 1024);
+        m_parser->body_limit(4 * 1024);  // the page never sends a body
+        m_stream.expires_after(std::chrono::seconds(30));
+        http::async_read(m_stream, m_buffer, *m_parser,
+                         beast::bind_front_handler(&HttpSession::on_read, shared_from_this()));
+    }
+
+    void on_read(beast::error_code ec, size_t) {
+        if (ec == http::error::end_of_stream) return shut();
+        if (ec) {
+            // Oversized or malformed requests get one plain answer, then the connection closes.
+            if (ec == http::error::header_limit || ec == http::error::body_limit ||
+                ec.category() == make_error_code(http::error::bad_target).category())
+                return respond(plain(http::status::bad_request, "bad request\n", 11, false));
+            return shut();
+        }
+        auto req = m_parser->release();
+        const std::string host(req[http::field::host]);
+        if (m_server->loopback && !is_loopback_name(host_name(host)))
+            return respond(plain(http::status::forbidden, "forbidden host\n", req.version(), false));
+        if (websocket::is_upgrade(req)) {
+            if (req.target() != "/ws")
+                return respond(plain(http::status::not_found, "not found\n", req.version(), false));
+            // A page from another site must not drive this server (cross-site WebSocket
+            // hijacking): a browser always sends Origin; it must be this server's own.
+            const auto origin = req[http::field::origin];
+            if (!origin.empty() && origin != "http://" + host)
+                return respond(plain(http::status::forbidden, "forbidden origin\n", req.version(), false));
+            if (int(m_server->sessions.size()) >= m_server->options.max_sessions)
+                return respond(plain(http::status::service_unavailable, "too many tabs\n",
+                                     req.version(), false));
+            beast::get_lowest_layer(m_stream).expires_never();
+            std::make_shared<WsSession>(m_stream.release_socket(), m_server)->run(std::move(req));
+            return;
+        }
+        if (req.method() != http::verb::get && req.method() != http::verb::head)
+            return respond(plain(http::status::method_not_allowed, "method not allowed\n",
+                                 req.version(), req.keep_alive()));
+        std::string_view target(req.target().data(), req.target().size());
+        target = target.substr(0, target.find('?'));
+        if (target == "/") target = "/index.html";
+        for (const Asset& a : assets()) {
+            if (a.path != target) continue;
+            http::response<http::string_body> res{http::status::ok, req.version()};
+            res.set(http::field::content_type, std::string(a.content_type));
+            secure_headers(res);
+            res.keep_alive(req.keep_alive());
+            if (req.method() == http::verb::get) res.body() = std::string(a.body);
+            res.content_length(a.body.size());
+            return respond(std::move(res));
+        }
+        return respond(plain(http::status::not_found, "not found\n", req.version(), req.keep_alive()));
+    }
+
+    template <class Res>
+    static void secure_headers(Res& res) {
+        res.set(http::field::server, "lacuna");
+        res.set(http::field::cache_control, "no-store");
+        res.set("X-Content-Type-Options", "nosniff");
+        res.set("X-Frame-Options", "DENY");
+        res.set("Content-Security-Policy",
+                "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'; "
+                "frame-ancestors 'none'");
+    }
+
+    static http::response<http::string_body> plain(http::status s, const char* body, unsigned version,
+                                                   bool keep_alive) {
+        http::response<http::string_body> res{s, version};
+        res.set(http::field::content_type, "text/plain; charset=utf-8");
+        secure_headers(res);
+        res.keep_alive(keep_alive);
+        res.body() = body;
+        res.prepare_payload();
+        return res;
+    }
+
+    void respond(http::response<http::string_body>&& res) {
+        auto sp = std::make_shared<http::response<http::string_body>>(std::move(res));
+        m_res = sp;
+        http::async_write(m_stream, *sp,
+                          [self = shared_from_this(), sp](beast::error_code ec, size_t) {
+                              if (ec || sp->need_eof()) return self->shut();
+                              self->read();
+                          });
+    }
+
+    void shut() {
+        beast::error_code ec;
+        m_stream.socket().shutdown(tcp::socket::shutdown_send, ec);
+    }
+
+    beast::tcp_stream m_stream;
+    std::shared_ptr<Server::Impl> m_server;
+    beast::flat_buffer m_buffer;
+    std::optional<http::request_parser<http::string_body>> m_parser;
+    std::shared_ptr<void> m_res;
+};
+
+void Server::Impl::accept() {
+    acceptor.async_accept(net::make_strand(ioc),
+                          beast::bind_front_handler(&Impl::on_accept, shared_from_this()));
+}
+
+void Server::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
+    if (stopping || !acceptor.is_open()) return;
+    if (!ec) std::make_shared<HttpSession>(std::move(socket), shared_from_this())->run();
+    accept();
+}
+
+void Server::Impl::submit(const std::shared_ptr<WsSession>& s) {
+    {
+        std::lock_guard<std::mutex> lock(slot_mutex);
+        if (s->in_ready) return;  // already waiting: its slot now holds the newer request
+        s->in_ready = true;
+        ready.push_back(s);
+    }
+    slot_cv.notify_one();
+}
+
+// The render thread: takes the tabs with a pending request in turn (round robin, so one busy
+// tab cannot starve another), renders each one's latest request, hands the JPEG to the network
+// thread.
+void Server::Impl::render_loop() {
+    for (;;) {
+        std::shared_ptr<WsSession> s;
+        ViewRequest req;
+        Clock::time_point received;
+        {
+            std::unique_lock<std::mutex> lock(slot_mutex);
+            slot_cv.wait(lock, [&] { return render_stop || !ready.empty(); });
+            if (render_stop) return;
+            s = ready.front().lock();
+            ready.pop_front();
+            if (!s) continue;
+            s->in_ready = false;
+            if (!s->pending) continue;
+            req = std::move(*s->pending);
+            s->pending.reset();
+            received = s->pending_received;
+        }
+        std::string message;
+        try {
+            // Previews (the page is dragging) are reduced so they take about a frame at 30 Hz,
+            // judged by the last full-resolution frame: 1/2, 1/3 or 1/4 per side.
+            int div = 1;
+            if (req.preview)
+                div = std::clamp(int(std::ceil(std::sqrt(last_full_ms / 33.0))), 2, 4);
+            const int w = std::max(1, req.width / div), h = std::max(1, req.height / div);
+            const Clock::time_point start = Clock::now();
+            Frame f = renderer.render(req, w, h);
+            if (!req.preview) last_full_ms = f.stats.seconds * 1e3;
+            FrameInfo info;
+            info.id = req.id;
+            info.width = w;
+            info.height = h;
+            info.preview = req.preview;
+            info.renderer = to_string(req.renderer);
+            info.accel = to_string(req.accel);
+            info.frame_ms = f.stats.seconds * 1e3;
+            info.samples_per_ray = f.stats.samples_per_ray();
+            info.skipped = f.skipped;
+            info.tf_changed = f.tf_changed;
+            info.tf_update_ms = f.tf_update_seconds * 1e3;
+            // Received -> ready to render: the wait for the frame in progress, the (possible)
+            // structure build and the TF update.
+            info.tf_latency_ms =
+                f.tf_changed ? ms_between(received, start) + f.accel_build_seconds * 1e3 +
+                                   f.tf_update_seconds * 1e3
+                             : 0;
+            info.accel_build_ms = f.accel_build_seconds * 1e3;
+            info.accel_tf_update_ms = f.accel_tf_update_seconds * 1e3;
+            const Clock::time_point e0 = Clock::now();
+            const std::string jpeg = encode_jpeg(
+                f.image, req.preview ? options.preview_quality : options.jpeg_quality);
+            info.encode_ms = ms_between(e0, Clock::now());
+            message = frame_message(info, jpeg);
+            net::post(ioc, [s, m = std::move(message)]() mutable { s->send_frame(std::move(m)); });
+        } catch (const std::exception& e) {
+            // lacuna::Error (e.g. a structure's options) or out of memory: report, keep serving.
+            net::post(ioc, [s, m = error_message(std::string("render: ") + e.what(), req.id)]() mutable {
+                s->send_text(std::move(m));
+            });
+        }
+    }
+}
+
+void Server::Impl::close_all() {
+    stopping = true;
+    beast::error_code ec;
+    acceptor.close(ec);
+    if (signals) signals->cancel(ec);
+    for (const auto& s : sessions) s->close();
+    sessions.clear();
+    ioc.stop();
+}
+
+Server::Server(FrameRenderer& renderer, ServerOptions options)
+    : m(std::make_shared<Impl>(renderer, std::move(options))) {
+    HelloInfo h;
+    h.volume_name = m->options.volume_name;
+    h.volume = &renderer.volume();
+    h.histogram = renderer.histogram();
+    h.initial_tf = m->options.initial_tf;
+    h.accels = accel_names();
+    h.renderers = renderer_names();
+    h.limits = m->options.limits;
+    m->hello = hello_message(h);
+}
+
+Server::~Server() {
+    stop();
+    if (m->render_thread.joinable()) {
+        {
+            std::lock_guard<std::mutex> lock(m->slot_mutex);
+            m->render_stop = true;
+        }
+        m->slot_cv.notify_all();
+        m->render_thread.join();
+    }
+}
+
+uint16_t Server::start() {
+    boost::system::error_code ec;
+    const auto address = net::ip::make_address(m->options.host, ec);
+    if (ec) throw Error("--host", "address", "expected an IP address, got '" + m->options.host + "'");
+    m->loopback = address.is_loopback();
+    const tcp::endpoint ep{address, m->options.port};
+    const std::string where = m->options.host + ":" + std::to_string(m->options.port);
+    m->acceptor.open(ep.protocol(), ec);
+    if (!ec) m->acceptor.set_option(net::socket_base::reuse_address(true), ec);
+    if (!ec) m->acceptor.bind(ep, ec);
+    if (!ec) m->acceptor.listen(net::socket_base::max_listen_connections, ec);
+    if (ec) throw Error("--port", where, "cannot listen: " + ec.message());
+    m->port = m->acceptor.local_endpoint().port();
+    m->accept();
+    if (m->options.handle_signals) {
+        m->signals.emplace(m->ioc, SIGINT, SIGTERM);
+        m->signals->async_wait([impl = m](const boost::system::error_code& e, int) {
+            if (!e) impl->close_all();
+        });
+    }
+    m->render_thread = std::thread([impl = m] { impl->render_loop(); });
+    return m->port;
+}
+
+void Server::run() {
+    m->ioc.run();
+    {
+        std::lock_guard<std::mutex> lock(m->slot_mutex);
+        m->render_stop = true;
+    }
+    m->slot_cv.notify_all();
+    if (m->render_thread.joinable()) m->render_thread.join();
+}
+
+void Server::stop() {
+    net::post(m->ioc, [impl = m] { impl->close_all(); });
+}
+
+std::string Server::url() const {
+    const bool v6 = m->options.host.find(':') != std::string::npos;
+    return "http://" + (v6 ? "[" + m->options.host + "]" : m->options.host) + ":" +
+           std::to_string(m->port) + "/";
+}
+
+}  // namespace lacuna::serve

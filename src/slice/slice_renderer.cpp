@@ -1,0 +1,433 @@
+#include "slice/slice_renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "core/parallel.h"
+#include "lacuna/error.h"
+#include "lacuna/renderer.h"
+#include "render/ray_march_kernel.h"
+#include "slice/polygon.h"
+
+namespace lacuna {
+
+std::string to_string(const SliceStats& s) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "%.1f ms (set-up %.1f%%, occlusion %.1f ms), %llu samples, %llu polygons, "
+                  "%llu boxes (%llu culled, %llu clipped), %.1f%% voxels skipped, %d/%d map updates",
+                  s.seconds * 1e3, 100 * s.setup_fraction(), s.occlusion_seconds * 1e3,
+                  (unsigned long long)s.samples, (unsigned long long)s.polygons,
+                  (unsigned long long)s.boxes, (unsigned long long)s.boxes_culled,
+                  (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction(), s.map_updates,
+                  s.desired_updates);
+    return buf;
+}
+
+SliceRenderer::SliceRenderer(const Volume& volume) : m_volume(volume) {}
+
+void SliceRenderer::set_transfer_function(const TransferLut& lut) { m_lut = lut; }
+
+Box3f SliceRenderer::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Per pixel: the ray in index space (t in world units) and the terms of t on plane k.
+struct PixelRays {
+    std::vector<float> ox, oy, oz, dx, dy, dz, a, c;
+};
+
+// Index space -> continuous pixel coordinates (pixel (x, y) has its centre at (x+0.5, y+0.5)),
+// the inverse of Camera::generate.
+struct ScreenProjection {
+    Vec3d eye, right, up, fwd, sp;
+    double sx, sy;  // aspect * half_h, half_h
+    double w, h;
+    bool persp;
+    void project(const Vec3d& p, double& u, double& v) const {
+        const Vec3d rel = Vec3d{p.x * sp.x, p.y * sp.y, p.z * sp.z} - eye;
+        double xr = dot(rel, right), yu = dot(rel, up);
+        if (persp) {
+            const double zf = dot(rel, fwd);
+            xr /= zf;
+            yu /= zf;
+        }
+        u = (xr / sx + 1.0) * 0.5 * w;
+        v = (1.0 - yu / sy) * 0.5 * h;
+    }
+};
+
+// A slicing polygon on screen.
+struct Poly {
+    int k;
+    int first, count;  // vertices in BoxWork::uv (pairs u, v)
+    float umin, umax, vmin, vmax;
+};
+
+// A box scheduled for rendering: who owns which samples, and its polygons.
+struct BoxWork {
+    float lo[3], hi_excl[3];  // ownership: lo <= P < hi_excl (the source's cell box)
+    float clo[3], chi[3];     // occlusion clip box: clo <= P <= chi
+    std::vector<Poly> polys;
+    std::vector<float> uv;
+    float umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+};
+
+struct Frame {
+    const Camera* cam;
+    Vec3d eye_world, fwd;
+    Vec3d sp;
+    double dt;
+    float dt_f;
+    ScreenProjection screen;
+};
+
+// The slicing polygons of the box [lo, hi] (index space) for every plane that may meet it.
+void set_up_box(const Frame& f, Vec3d lo, Vec3d hi, BoxWork& out, uint64_t& polygons) {
+    // A margin so a plane that grazes the box in one rounding still yields a polygon; the
+    // ownership test decides which samples are taken.
+    const double eps = 1e-3;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] -= eps;
+        hi[a] += eps;
+    }
+    const Vec3d n{f.sp.x * f.fwd.x, f.sp.y * f.fwd.y, f.sp.z * f.fwd.z};  // g(P) = dot(n, P)
+    const double g_eye = dot(f.eye_world, f.fwd);
+    double zmin = INFINITY, zmax = -INFINITY;
+    for (int c = 0; c < 8; ++c) {
+        Vec3d p;
+        for (int a = 0; a < 3; ++a) p[a] = (c >> a) & 1 ? hi[a] : lo[a];
+        const double z = dot(n, p) - g_eye;
+        zmin = std::min(zmin, z);
+        zmax = std::max(zmax, z);
+    }
+    const int k0 = std::max(0, int(std::ceil(zmin / f.dt - 0.5)) - 1);
+    const int k1 = int(std::floor(zmax / f.dt - 0.5)) + 1;
+    if (k1 < k0) return;
+    IncrementalSlicer slicer(lo, hi, n, (k0 + 0.5) * f.dt + g_eye, f.dt);
+    SlicePolygon poly;
+    for (int k = k0; k <= k1; ++k) {
+        slicer.next(poly);
+        if (poly.count == 0) continue;
+        Poly p{k, int(out.uv.size() / 2), poly.count, INFINITY, -INFINITY, INFINITY, -INFINITY};
+        for (int i = 0; i < poly.count; ++i) {
+            double u, v;
+            f.screen.project(poly.v[size_t(i)], u, v);
+            out.uv.push_back(float(u));
+            out.uv.push_back(float(v));
+            p.umin = std::min(p.umin, float(u));
+            p.umax = std::max(p.umax, float(u));
+            p.vmin = std::min(p.vmin, float(v));
+            p.vmax = std::max(p.vmax, float(v));
+        }
+        if (!(p.umax >= p.umin && p.vmax >= p.vmin)) continue;  // NaN: behind the eye
+        out.umin = std::min(out.umin, p.umin);
+        out.umax = std::max(out.umax, p.umax);
+        out.vmin = std::min(out.vmin, p.vmin);
+        out.vmax = std::max(out.vmax, p.vmax);
+        out.polys.push_back(p);
+        ++polygons;
+    }
+}
+
+// Horizontal extent [u0, u1] of the convex hull of the polygon's vertices at height v: the
+// extreme crossings of all vertex pairs (robust to any vertex order and to degenerate polygons).
+inline bool span_at(const float* uv, int n, float v, float& u0, float& u1) {
+    u0 = INFINITY;
+    u1 = -INFINITY;
+    for (int i = 0; i < n; ++i) {
+        const float ui = uv[2 * i], vi = uv[2 * i + 1];
+        if (vi == v) {
+            u0 = std::min(u0, ui);
+            u1 = std::max(u1, ui);
+        }
+        for (int j = i + 1; j < n; ++j) {
+            const float uj = uv[2 * j], vj = uv[2 * j + 1];
+            if ((vi - v) * (vj - v) < 0.f) {
+                const float u = ui + (v - vi) * (uj - ui) / (vj - vi);
+                u0 = std::min(u0, u);
+                u1 = std::max(u1, u);
+            }
+        }
+    }
+    return u0 <= u1;
+}
+
+// Composites the boxes of one batch into the tile [x0, x1) x [y0, y1), box after box, each
+// polygon front to back.
+template <class T>
+void raster_tile(const kernel::Grid<T, int64_t>& g, const Rgba* lut, ValueToLut map,
+                 const PixelRays& px, const std::vector<const BoxWork*>& batch, float dt, float ert,
+                 int width, int x0, int y0, int x1, int y1, kernel::Accum* fb, uint64_t& samples) {
+    for (const BoxWork* b : batch) {
+        if (b->polys.empty() || b->umax < float(x0) - 1.f || b->umin > float(x1) + 1.f ||
+            b->vmax < float(y0) - 1.f || b->vmin > float(y1) + 1.f)
+            continue;
+        for (const Poly& p : b->polys) {
+            if (p.umax < float(x0) - 1.f || p.umin > float(x1) + 1.f ||
+                p.vmax < float(y0) - 1.f || p.vmin > float(y1) + 1.f)
+                continue;
+            const float* uv = &b->uv[size_t(p.first) * 2];
+            const float zk = (float(p.k) + 0.5f) * dt;  // the plane, independent of the box
+            // Rows and columns clamped to the tile before converting (vertices near the eye
+            // can project far off screen).
+            const int ya = int(std::ceil(std::clamp(p.vmin - 0.5f, float(y0) + 1.f, float(y1)))) - 1;
+            const int yb =
+                std::min(y1 - 1, int(std::floor(std::clamp(p.vmax - 0.5f, float(y0) - 2.f, float(y1)))) + 1);
+            for (int y = ya; y <= yb; ++y) {
+                float u0, u1;
+                const float vc = std::clamp(float(y) + 0.5f, p.vmin, p.vmax);
+                if (!span_at(uv, p.count, vc, u0, u1)) continue;
+                // Every pixel whose sample on this plane may lie in the box, with a margin of
+                // one pixel for rounding; the ownership test below decides.
+                const int xa = int(std::ceil(std::clamp(u0 - 0.5f, float(x0) + 1.f, float(x1)))) - 1;
+                const int xb = std::min(
+                    x1 - 1, int(std::floor(std::clamp(u1 - 0.5f, float(x0) - 2.f, float(x1)))) + 1);
+                for (int x = xa; x <= xb; ++x) {
+                    const size_t i = size_t(y) * size_t(width) + size_t(x);
+                    kernel::Accum& acc = fb[i];
+                    if (acc.a >= ert) continue;  // terminated pixel
+                    // The lattice sample (pixel, plane), computed only from those two.
+                    const float t = (zk - px.a[i]) * px.c[i];
+                    const float sx = px.ox[i] + t * px.dx[i];
+                    const float sy = px.oy[i] + t * px.dy[i];
+                    const float sz = px.oz[i] + t * px.dz[i];
+                    // Ownership (half-open cell box) and the occlusion clip box.
+                    if (!(sx >= b->lo[0] && sx < b->hi_excl[0] && sy >= b->lo[1] &&
+                          sy < b->hi_excl[1] && sz >= b->lo[2] && sz < b->hi_excl[2] &&
+                          sx >= b->clo[0] && sx <= b->chi[0] && sy >= b->clo[1] &&
+                          sy <= b->chi[1] && sz >= b->clo[2] && sz <= b->chi[2]))
+                        continue;
+                    const Rgba& c = lut[map(kernel::trilinear(g, sx, sy, sz))];
+                    ++samples;
+                    const float w = 1.f - acc.a;
+                    acc.r += w * c.r;
+                    acc.g += w * c.g;
+                    acc.b += w * c.b;
+                    acc.a += w * c.a;
+                }
+            }
+        }
+    }
+}
+
+double cells_of(const Vec3d& lo, const Vec3d& hi) {
+    return std::max(hi.x - lo.x, 0.0) * std::max(hi.y - lo.y, 0.0) * std::max(hi.z - lo.z, 0.0);
+}
+
+}  // namespace
+
+SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
+                                  AdaptiveUpdates* adaptive) const {
+    if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
+    if (!(opt.step > 0.f) || !std::isfinite(opt.step))
+        throw Error("--step", "step", "expected a positive number");
+    if (cam.width() < 1 || cam.height() < 1)
+        throw Error("--size", "image size", "expected at least 1x1 pixels");
+    const OcclusionOptions& oo = opt.occlusion;
+    if (oo.mode != OcclusionMode::Off) {
+        if (!(oo.threshold > 0.f && oo.threshold <= 1.f))
+            throw Error("--occlusion-threshold", "threshold", "expected 0 < T <= 1");
+        if (oo.map_size < 1 || oo.map_size > 4096)
+            throw Error("--occlusion-map", "map size", "expected 1..4096");
+        if (oo.updates < 0) throw Error("occlusion", "updates", "expected >= 0");
+    }
+    const auto t_start = Clock::now();
+    const int W = cam.width(), H = cam.height();
+    const size_t np = size_t(W) * size_t(H);
+    SliceResult out;
+    out.image = Image(W, H);
+    SliceStats& st = out.stats;
+
+    // 1. Per-pixel rays (index space) and plane terms.
+    const Vec3d sp = m_volume.spacing;
+    const Vec3f inv_sp{float(1.0 / sp.x), float(1.0 / sp.y), float(1.0 / sp.z)};
+    const Vec3f eye = cam.eye(), fwd = cam.forward();
+    PixelRays px;
+    for (auto* v : {&px.ox, &px.oy, &px.oz, &px.dx, &px.dy, &px.dz, &px.a, &px.c}) v->resize(np);
+    parallel_for(size_t(H), opt.threads, [&](size_t r0, size_t r1) {
+        for (size_t y = r0; y < r1; ++y)
+            for (int x = 0; x < W; ++x) {
+                const size_t i = y * size_t(W) + size_t(x);
+                const Ray wr = cam.generate(float(x), float(y));
+                const Vec3f o = wr.origin * inv_sp, d = wr.dir * inv_sp;
+                px.ox[i] = o.x, px.oy[i] = o.y, px.oz[i] = o.z;
+                px.dx[i] = d.x, px.dy[i] = d.y, px.dz[i] = d.z;
+                px.a[i] = dot(wr.origin - eye, fwd);
+                px.c[i] = 1.f / dot(wr.dir, fwd);
+            }
+    });
+
+    // 2. The boxes, front to back.
+    const Vec3i dims = m_volume.dims();
+    const int cells[3] = {dims.x - 1, dims.y - 1, dims.z - 1};
+    std::vector<CellBox> boxes;
+    if (m_source) {
+        const Vec3f e_idx = eye * inv_sp, f_idx = fwd * inv_sp;
+        boxes = cam.projection() == Projection::Orthographic
+                    ? m_source->boxes_front_to_back_along(f_idx)
+                    : m_source->boxes_front_to_back(e_idx);
+    } else {
+        boxes.push_back({{0, 0, 0}, {cells[0], cells[1], cells[2]}});
+    }
+    st.boxes = boxes.size();
+    for (const CellBox& b : boxes)
+        st.voxels += cells_of({double(b.lo[0]), double(b.lo[1]), double(b.lo[2])},
+                              {double(b.hi[0]), double(b.hi[1]), double(b.hi[2])});
+
+    Frame f;
+    f.cam = &cam;
+    f.eye_world = Vec3d(eye);
+    f.fwd = Vec3d(fwd);
+    f.sp = sp;
+    const float min_sp = float(std::min({sp.x, sp.y, sp.z}));
+    f.dt_f = opt.step * min_sp;
+    f.dt = double(f.dt_f);
+    const double aspect = double(W) / double(H);
+    f.screen = {f.eye_world, Vec3d(cam.right()), Vec3d(cam.up()), f.fwd, sp,
+                aspect * cam.half_height(), double(cam.half_height()), double(W), double(H),
+                cam.projection() == Projection::Perspective};
+
+    // 3. Occlusion: the map's geometry and each pixel's cells, the DeltaVoxels schedule.
+    const bool occl = oo.mode != OcclusionMode::Off;
+    std::unique_ptr<OcclusionMap> omap;
+    double delta_voxels = INFINITY;
+    if (occl) {
+        const auto t0 = Clock::now();
+        omap = std::make_unique<OcclusionMap>(cam, dims, sp, oo.map_size);
+        omap->assign_pixels(px.ox, px.oy, px.oz, px.dx, px.dy, px.dz);
+        st.desired_updates = adaptive ? adaptive->desired() : oo.updates;
+        delta_voxels = st.voxels / double(st.desired_updates + 1);
+        st.occlusion_seconds += seconds_since(t0);
+    }
+
+    std::vector<kernel::Accum> fb(np);
+    const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
+    const ValueToLut vmap = m_lut.map();
+    std::atomic<uint64_t> samples{0};
+    const float ert = opt.ert >= 1.f ? 2.f : opt.ert;
+
+    // 4. Batches of boxes between map updates (one batch without occlusion).
+    double rendered = 0, next_update = delta_voxels;
+    size_t next_box = 0;
+    std::vector<BoxWork> work;
+    while (next_box < boxes.size()) {
+        // 4a. Cull and clip the boxes of the batch against the current map.
+        const auto t_occ = Clock::now();
+        work.clear();
+        bool update_after = false;
+        std::vector<std::pair<Vec3d, Vec3d>> regions;
+        while (next_box < boxes.size()) {
+            const CellBox& cb = boxes[next_box++];
+            const Vec3d lo{double(cb.lo[0]), double(cb.lo[1]), double(cb.lo[2])};
+            const Vec3d hi{double(cb.hi[0]), double(cb.hi[1]), double(cb.hi[2])};
+            Vec3d rlo = lo, rhi = hi;
+            if (occl && omap->valid()) {
+                const BoxClip bc = clip_box(*omap, lo, hi, oo.threshold);
+                const double vol = cells_of(lo, hi);
+                if (oo.mode == OcclusionMode::CullClip || oo.mode == OcclusionMode::CullOnly) {
+                    if (bc.culled) {
+                        ++st.boxes_culled;
+                        st.voxels_culled += vol;
+                        continue;
+                    }
+                }
+                if (oo.mode == OcclusionMode::CullClip && !(bc.lo == lo && bc.hi == hi)) {
+                    ++st.boxes_clipped;
+                    st.voxels_clipped += vol - cells_of(bc.lo, bc.hi);
+                    rlo = bc.lo;
+                    rhi = bc.hi;
+                }
+            }
+            BoxWork w;
+            for (int a = 0; a < 3; ++a) {
+                w.lo[a] = float(cb.lo[a]);
+                w.hi_excl[a] = cb.hi[a] >= cells[a] ? std::nextafter(float(cb.hi[a]), INFINITY)
+                                                    : float(cb.hi[a]);
+                // Rounded outward: the clip box may take a sample more, never one less.
+                w.clo[a] = std::nextafter(float(rlo[a]), -INFINITY);
+                w.chi[a] = std::nextafter(float(rhi[a]), INFINITY);
+            }
+            work.push_back(std::move(w));
+            regions.push_back({rlo, rhi});
+            rendered += cells_of(rlo, rhi);
+            if (occl && rendered >= next_update && next_box < boxes.size()) {
+                next_update = (std::floor(rendered / delta_voxels) + 1) * delta_voxels;
+                update_after = true;
+                break;
+            }
+        }
+        if (occl) st.occlusion_seconds += seconds_since(t_occ);
+
+        // 4b. Slicing polygons of every box in the batch (incremental intersection).
+        const auto t_setup = Clock::now();
+        std::vector<uint64_t> polys(work.size(), 0);
+        parallel_for(work.size(), opt.threads, [&](size_t b0, size_t b1) {
+            for (size_t b = b0; b < b1; ++b)
+                set_up_box(f, regions[b].first, regions[b].second, work[b], polys[b]);
+        });
+        for (uint64_t n : polys) st.polygons += n;
+        st.setup_seconds += seconds_since(t_setup);
+
+        // 4c. Composite the batch, tile by tile.
+        std::vector<const BoxWork*> batch;
+        for (const BoxWork& w : work) batch.push_back(&w);
+        visit_voxels(m_volume, [&](const auto* data) {
+            using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
+            const kernel::Grid<T, int64_t> g{data,
+                                             ptrdiff_t(dims.x),
+                                             ptrdiff_t(dims.x) * ptrdiff_t(dims.y),
+                                             float(dims.x - 1),
+                                             float(dims.y - 1),
+                                             float(dims.z - 1),
+                                             dims.x - 2,
+                                             dims.y - 2,
+                                             dims.z - 2};
+            parallel_for_tiles(W, H, std::max(opt.tile, 1), opt.threads,
+                               [&](int x0, int y0, int x1, int y1) {
+                                   uint64_t n = 0;
+                                   raster_tile(g, lut.data(), vmap, px, batch, f.dt_f, ert, W,
+                                               x0, y0, x1, y1, fb.data(), n);
+                                   samples += n;
+                               });
+        });
+
+        // 4d. Map update after DeltaVoxels more voxels.
+        if (update_after) {
+            const auto t0 = Clock::now();
+            omap->update(&fb[0].a, 4);
+            ++st.map_updates;
+            st.occlusion_seconds += seconds_since(t0);
+        }
+    }
+
+    // 5. Background and 8 bits, as the ray marcher.
+    if (opt.keep_float) out.rgba_float.resize(np * 4);
+    for (size_t i = 0; i < np; ++i) {
+        const kernel::Accum& acc = fb[i];
+        const float w = 1.f - acc.a;
+        const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
+                              acc.b + w * opt.background.z};
+        uint8_t* p = &out.image.rgba[i * 4];
+        for (int c = 0; c < 3; ++c) p[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
+        p[3] = 255;
+        if (opt.keep_float) {
+            float* q = &out.rgba_float[i * 4];
+            q[0] = acc.r, q[1] = acc.g, q[2] = acc.b, q[3] = acc.a;
+        }
+    }
+    st.samples = samples;
+    st.seconds = seconds_since(t_start);
+    if (adaptive && occl) adaptive->report(st.skipped_fraction(), st.map_updates);
+    return out;
+}
+
+}  // namespace lacuna

@@ -1,0 +1,189 @@
+// The viewer's frames are the CLI's images: same settings, same bytes; every structure gives
+// the `none` image through TF changes and structure switches; the overlay's numbers are exact.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "lacuna/error.h"
+#include "lacuna/io.h"
+#include "lacuna/synthetic.h"
+#include "serve/frame_renderer.h"
+#include "serve/jpeg.h"
+
+namespace fs = std::filesystem;
+using namespace lacuna;
+using namespace lacuna::serve;
+
+namespace {
+
+fs::path temp_dir() {
+    static fs::path dir = [] {
+        fs::path d = fs::temp_directory_path() / ("lacuna-serve-" + std::to_string(::getpid()));
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+const fs::path& shells_file() {
+    static fs::path p = [] {
+        SyntheticOptions so;
+        so.dims = {33, 30, 27};
+        const fs::path v = temp_dir() / "shells.nrrd";
+        write_volume(v.string(), generate(SyntheticKind::SphereShells, so));
+        return v;
+    }();
+    return p;
+}
+
+ViewRequest request(AccelKind accel, const std::string& tf) {
+    ViewRequest r;
+    r.width = 40;
+    r.height = 36;
+    r.camera.azimuth = 40;
+    r.camera.elevation = 20;
+    r.camera.zoom = 1.3f;
+    r.accel = accel;
+    r.ert = false;
+    r.step = 0.5f;
+    r.tf = preset(tf);
+    return r;
+}
+
+}  // namespace
+
+TEST(FrameRenderer, SameBytesAsTheCliRenderer) {
+    for (const bool ert : {false, true}) {
+        const fs::path out = temp_dir() / (ert ? "cli_ert.png" : "cli.png");
+        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " +
+                                shells_file().string() +
+                                " --tf mr-default --accel bitfield --width 40 --height 36"
+                                " --azimuth 40 --elevation 20 --zoom 1.3 --step 0.5 --ert " +
+                                (ert ? "0.99" : "1") + " --out " + out.string() + " >/dev/null";
+        const int status = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+        const Image cli = read_png(out.string());
+
+        FrameRenderer fr(read_volume(shells_file().string()));
+        ViewRequest req = request(AccelKind::Bitfield, "mr-default");
+        req.ert = ert;
+        const Frame f = fr.render(req, 40, 36);
+        ASSERT_EQ(f.image.width, cli.width);
+        ASSERT_EQ(f.image.height, cli.height);
+        EXPECT_EQ(f.image.rgba, cli.rgba) << "ert " << ert;
+    }
+}
+
+TEST(FrameRenderer, EveryStructureMatchesNoneThroughTfChangesAndSwitches) {
+    SyntheticOptions so;
+    so.dims = {25, 21, 19};
+    FrameRenderer fr(generate(SyntheticKind::NoiseBlobs, so));
+    FrameRenderer reference(generate(SyntheticKind::NoiseBlobs, so));
+    // Structures are visited in turn while the TF changes between them, so each one has to
+    // catch up with TF changes it missed.
+    const char* tfs[] = {"mr-default", "mr-gap", "mr-brain", "mr-skin"};
+    int i = 0;
+    for (const AccelKind k : all_accel_kinds()) {
+        for (int pass = 0; pass < 2; ++pass, ++i) {
+            ViewRequest req = request(k, tfs[i % 4]);
+            req.ert = pass == 1;
+            req.camera.pan_x = 0.1f * float(pass);
+            const Frame f = fr.render(req, 32, 24);
+            req.accel = AccelKind::None;
+            const Frame ref = reference.render(req, 32, 24);
+            EXPECT_EQ(f.image.rgba, ref.image.rgba) << to_string(k) << " pass " << pass;
+            EXPECT_LE(f.stats.samples, ref.stats.samples) << to_string(k);
+        }
+    }
+}
+
+TEST(FrameRenderer, ReportsTfChangesBuildsAndSkippedSpace) {
+    SyntheticOptions so;
+    so.dims = {32, 32, 32};
+    AccelOptions ao;
+    ao.leaf_cells = 2;  // fine leaves, so the sphere's empty surroundings are skippable
+    FrameRenderer fr(generate(SyntheticKind::Sphere, so), ao);
+    ViewRequest req = request(AccelKind::None, "mr-default");
+    Frame f = fr.render(req, 30, 30);
+    EXPECT_TRUE(f.tf_changed);
+    // No skipping, no early termination: every lattice sample is taken.
+    EXPECT_GT(f.lattice_samples, 0u);
+    EXPECT_EQ(f.stats.samples, f.lattice_samples);
+    EXPECT_EQ(f.skipped, 0.0);
+
+    f = fr.render(req, 30, 30);  // same TF: no change
+    EXPECT_FALSE(f.tf_changed);
+    EXPECT_EQ(f.tf_update_seconds, 0.0);
+
+    req.accel = AccelKind::Bitfield;
+    f = fr.render(req, 30, 30);
+    EXPECT_FALSE(f.tf_changed);
+    EXPECT_GT(f.accel_build_seconds, 0.0);  // built lazily, now
+    // The sphere fills a fraction of its box: the structure skips a good part of the lattice.
+    EXPECT_GT(f.skipped, 0.2);
+    EXPECT_LT(f.skipped, 1.0);
+    EXPECT_NEAR(double(f.stats.samples), double(f.lattice_samples) * (1.0 - f.skipped), 1e-6 * double(f.lattice_samples));
+
+    req.tf = preset("mr-brain");
+    f = fr.render(req, 30, 30);
+    EXPECT_TRUE(f.tf_changed);
+    EXPECT_EQ(f.accel_build_seconds, 0.0);  // already built
+    EXPECT_GT(f.tf_update_seconds, 0.0);
+}
+
+TEST(FrameRenderer, PanMovesTheImage) {
+    SyntheticOptions so;
+    so.dims = {20, 20, 20};
+    FrameRenderer fr(generate(SyntheticKind::Sphere, so));
+    ViewRequest req = request(AccelKind::None, "mr-default");
+    const Frame centred = fr.render(req, 24, 24);
+    req.camera.pan_x = 0.3f;
+    const Frame panned = fr.render(req, 24, 24);
+    EXPECT_NE(centred.image.rgba, panned.image.rgba);
+    // A pan by zero is the unpanned camera exactly.
+    req.camera.pan_x = 0.f;
+    EXPECT_EQ(fr.render(req, 24, 24).image.rgba, centred.image.rgba);
+}
+
+TEST(FrameRenderer, HistogramCountsEveryVoxel) {
+    SyntheticOptions so;
+    so.dims = {17, 13, 11};
+    Volume v = generate(SyntheticKind::SphereShells, so);
+    // Brute force over the same bins.
+    std::vector<uint64_t> expect(FrameRenderer::kHistogramBins, 0);
+    const ValueRange r = v.vis_range();
+    for (int k = 0; k < 11; ++k)
+        for (int j = 0; j < 13; ++j)
+            for (int i = 0; i < 17; ++i) {
+                const double u = (double(v.value(i, j, k)) - r.min) * FrameRenderer::kHistogramBins /
+                                 (double(r.max) - r.min);
+                ++expect[size_t(std::clamp(int(u), 0, FrameRenderer::kHistogramBins - 1))];
+            }
+    FrameRenderer fr(std::move(v));
+    EXPECT_EQ(fr.histogram(), expect);
+}
+
+TEST(Jpeg, EncodesABaselineJpegOfTheImageSize) {
+    Image img(37, 21);
+    for (int y = 0; y < 21; ++y)
+        for (int x = 0; x < 37; ++x) {
+            img.pixel(x, y)[0] = uint8_t(x * 6);
+            img.pixel(x, y)[1] = uint8_t(y * 12);
+            img.pixel(x, y)[3] = 255;
+        }
+    const std::string j = encode_jpeg(img, 80);
+    ASSERT_GT(j.size(), 100u);
+    EXPECT_EQ(uint8_t(j[0]), 0xFF);
+    EXPECT_EQ(uint8_t(j[1]), 0xD8);  // SOI
+    EXPECT_EQ(uint8_t(j[j.size() - 2]), 0xFF);
+    EXPECT_EQ(uint8_t(j[j.size() - 1]), 0xD9);  // EOI
+    // The SOF0 segment carries height and width.
+    const size_t sof = j.find("\xFF\xC0");
+    ASSERT_NE(sof, std::string::npos);
+    EXPECT_EQ((uint8_t(j[sof + 5]) << 8) | uint8_t(j[sof + 6]), 21);
+    EXPECT_EQ((uint8_t(j[sof + 7]) << 8) | uint8_t(j[sof + 8]), 37);
+    EXPECT_THROW(encode_jpeg(Image(), 80), Error);
+}

@@ -1,0 +1,483 @@
+// lacuna viewer: the page side of `lacuna serve` (docs/viewer.md). Plain JavaScript, no
+// dependencies. The server renders; this page sends the whole view state with every request
+// and shows the JPEG frames it gets back.
+//
+// Flow control: at most one request is in flight; input that arrives meanwhile marks the view
+// dirty and the newest state goes out when the frame arrives (the server also keeps only the
+// latest request per tab). While the camera moves or a TF point is dragged the page asks for
+// previews (the server renders them at reduced resolution); 150 ms after the last input it asks
+// for the full-resolution frame.
+'use strict';
+
+(() => {
+  const $ = (id) => document.getElementById(id);
+  const view = $('view'), img = $('frame');
+  const tfCanvas = $('tf'), colorCanvas = $('colors');
+
+  const state = {
+    camera: { azimuth: 30, elevation: 15, zoom: 1, pan: [0, 0] },
+    renderer: 'march',
+    accel: 'bitfield',
+    ert: true,
+    step: 0.5,
+    // TF in the normalized domain: x in [0,1] across the volume's visualization range (or
+    // tf.range when set). color: [x, r, g, b]; opacity: [x, a].
+    tf: null,
+  };
+  let hello = null;
+  let ws = null;
+  let nextId = 1;
+  let inFlight = null;      // id of the request awaiting its frame
+  let dirty = false;        // the view changed since the last request went out
+  let dirtyPreview = false;
+  let interacting = false;  // pointer held on the view or a TF point
+  let idleTimer = 0;
+  let frames = 0;
+  let lastFrameAt = 0, fps = 0;
+  let lastTfReport = null;
+  let currentUrl = null;
+  let selectedStop = -1;
+
+  // ---- connection -------------------------------------------------------------------------
+  function connect() {
+    ws = new WebSocket(`ws://${location.host}/ws`);
+    ws.binaryType = 'arraybuffer';
+    ws.onmessage = (ev) => {
+      if (typeof ev.data === 'string') onText(JSON.parse(ev.data));
+      else onFrame(ev.data);
+    };
+    ws.onclose = () => {
+      setStatus('disconnected: is `lacuna serve` still running?');
+      inFlight = null;
+    };
+  }
+
+  function onText(msg) {
+    if (msg.type === 'hello') return onHello(msg);
+    if (msg.type === 'error') {
+      // The server rejected a request: show it (not a console error: the page stays usable).
+      setStatus('server: ' + msg.message);
+      if (msg.id !== null && msg.id === inFlight) { inFlight = null; flush(); }
+    }
+  }
+
+  function onHello(msg) {
+    hello = msg;
+    $('title').textContent = `lacuna · ${msg.volume.name} (${msg.volume.dims.join('×')} ${msg.volume.type})`;
+    fillSelect($('renderer'), msg.renderers, state.renderer);
+    state.renderer = $('renderer').value;
+    fillSelect($('accel'), msg.accels, msg.accels.includes('bitfield') ? 'bitfield' : msg.accels[0]);
+    state.accel = $('accel').value;
+    const presets = $('preset');
+    for (const name of Object.keys(msg.presets)) {
+      const o = document.createElement('option');
+      o.value = o.textContent = name;
+      presets.appendChild(o);
+    }
+    setTf(msg.tf);
+    presets.value = msg.presets[msg.tf.name] ? msg.tf.name : '';
+    setStatus('');
+    request(false);
+  }
+
+  function onFrame(buf) {
+    const bytes = new Uint8Array(buf);
+    const n = bytes[0] | (bytes[1] << 8) | (bytes[2] << 16) | (bytes[3] << 24);
+    const header = JSON.parse(new TextDecoder().decode(bytes.subarray(4, 4 + n)));
+    const url = URL.createObjectURL(new Blob([bytes.subarray(4 + n)], { type: 'image/jpeg' }));
+    img.onload = () => {
+      if (currentUrl) URL.revokeObjectURL(currentUrl);
+      currentUrl = url;
+      frames += 1;
+      document.body.dataset.frames = String(frames);
+    };
+    img.src = url;
+    const now = performance.now();
+    if (lastFrameAt) fps = 0.8 * fps + 0.2 * (1000 / Math.max(1, now - lastFrameAt));
+    lastFrameAt = now;
+    showStats(header);
+    if (header.id === inFlight) inFlight = null;
+    flush();
+  }
+
+  // ---- requests ---------------------------------------------------------------------------
+  // Marks the view as changed; preview while the user is interacting.
+  function request(preview) {
+    dirty = true;
+    dirtyPreview = preview;
+    clearTimeout(idleTimer);
+    if (preview) idleTimer = setTimeout(() => { if (!interacting) request(false); }, 150);
+    flush();
+  }
+
+  function flush() {
+    if (!dirty || inFlight !== null || !ws || ws.readyState !== WebSocket.OPEN || !state.tf) return;
+    const dpr = Math.min(window.devicePixelRatio || 1, 2);
+    const max = hello ? hello.limits.max_side : 2048;
+    const w = Math.max(1, Math.min(max, Math.round(view.clientWidth * dpr)));
+    const h = Math.max(1, Math.min(max, Math.round(view.clientHeight * dpr)));
+    const id = nextId++;
+    ws.send(JSON.stringify({
+      type: 'render', id, width: w, height: h, preview: dirtyPreview,
+      camera: state.camera, renderer: state.renderer, accel: state.accel,
+      ert: state.ert, step: state.step, tf: state.tf,
+    }));
+    inFlight = id;
+    dirty = false;
+  }
+
+  // ---- overlay ----------------------------------------------------------------------------
+  function setStatus(text) {
+    $('status').textContent = text;
+    $('status').style.display = text ? '' : 'none';
+  }
+
+  function showStats(h) {
+    $('o-frame').textContent =
+      `${h.frame_ms.toFixed(1)} ms, ${h.width}×${h.height}${h.preview ? ' (preview)' : ''}, ${fps.toFixed(1)} fps`;
+    $('o-spr').textContent = h.samples_per_ray.toFixed(1);
+    $('o-skipped').textContent = (100 * h.skipped).toFixed(1) + ' %';
+    if (h.tf_changed) {
+      lastTfReport = h;
+      $('o-tf').textContent =
+        `${h.tf_update_ms.toFixed(2)} ms update, ${h.tf_latency_ms.toFixed(2)} ms from message`;
+      $('o-tf').dataset.ms = String(h.tf_update_ms);
+    }
+    $('o-accel').textContent = h.accel +
+      (h.accel_build_ms > 0 ? ` (built in ${h.accel_build_ms.toFixed(0)} ms)` : '') +
+      (lastTfReport ? '' : '');
+  }
+
+  // ---- camera: orbit, pan, zoom (mouse and touch through pointer events) -------------------
+  const pointers = new Map();
+  let pinch = null;
+
+  view.addEventListener('contextmenu', (e) => e.preventDefault());
+  view.addEventListener('pointerdown', (e) => {
+    view.setPointerCapture(e.pointerId);
+    pointers.set(e.pointerId, { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey });
+    interacting = true;
+    view.classList.add('dragging');
+    if (pointers.size === 2) pinch = pinchState();
+  });
+  view.addEventListener('pointermove', (e) => {
+    const p = pointers.get(e.pointerId);
+    if (!p) return;
+    const dx = e.clientX - p.x, dy = e.clientY - p.y;
+    p.x = e.clientX;
+    p.y = e.clientY;
+    const cam = state.camera;
+    if (pointers.size >= 2) {
+      const now = pinchState();
+      if (pinch && pinch.dist > 0) cam.zoom = clamp(cam.zoom * now.dist / pinch.dist, 0.1, 40);
+      panBy(now.cx - pinch.cx, now.cy - pinch.cy);
+      pinch = now;
+    } else if (p.pan) {
+      panBy(dx, dy);
+    } else {
+      cam.azimuth = (cam.azimuth - dx * 0.4) % 360;
+      cam.elevation = clamp(cam.elevation + dy * 0.4, -89, 89);
+    }
+    request(true);
+  });
+  const release = (e) => {
+    pointers.delete(e.pointerId);
+    pinch = pointers.size === 2 ? pinchState() : null;
+    if (pointers.size === 0) {
+      interacting = false;
+      view.classList.remove('dragging');
+      request(false);
+    }
+  };
+  view.addEventListener('pointerup', release);
+  view.addEventListener('pointercancel', release);
+  view.addEventListener('wheel', (e) => {
+    e.preventDefault();
+    state.camera.zoom = clamp(state.camera.zoom * Math.exp(-e.deltaY * 0.0015), 0.1, 40);
+    request(true);
+  }, { passive: false });
+  view.addEventListener('dblclick', () => {
+    state.camera = { azimuth: 30, elevation: 15, zoom: 1, pan: [0, 0] };
+    request(false);
+  });
+
+  function pinchState() {
+    const [a, b] = [...pointers.values()];
+    return { dist: Math.hypot(a.x - b.x, a.y - b.y), cx: (a.x + b.x) / 2, cy: (a.y + b.y) / 2 };
+  }
+  // Pan in bounding radii: a drag across the view's height moves about two radii / zoom.
+  function panBy(dx, dy) {
+    const k = 2 / (Math.max(1, view.clientHeight) * state.camera.zoom);
+    state.camera.pan = [clamp(state.camera.pan[0] - dx * k, -50, 50),
+                        clamp(state.camera.pan[1] + dy * k, -50, 50)];
+  }
+  window.addEventListener('resize', () => request(false));
+
+  // ---- controls -----------------------------------------------------------------------------
+  function fillSelect(sel, names, value) {
+    sel.innerHTML = '';
+    for (const n of names) {
+      const o = document.createElement('option');
+      o.value = o.textContent = n;
+      sel.appendChild(o);
+    }
+    sel.value = names.includes(value) ? value : names[0];
+  }
+  $('renderer').addEventListener('change', (e) => { state.renderer = e.target.value; request(false); });
+  $('accel').addEventListener('change', (e) => { state.accel = e.target.value; request(false); });
+  $('ert').addEventListener('change', (e) => { state.ert = e.target.checked; request(false); });
+  $('step').addEventListener('input', (e) => {
+    state.step = Number(e.target.value);
+    $('step-value').textContent = e.target.value;
+    request(true);
+  });
+  $('preset').addEventListener('change', (e) => {
+    if (!e.target.value) return;
+    setTf(hello.presets[e.target.value]);
+    request(false);
+  });
+  $('logscale').addEventListener('change', drawTf);
+
+  // ---- transfer function editor -------------------------------------------------------------
+  // Takes a TF from the server (a preset or the initial one) into the editor's normalized form.
+  function setTf(tf) {
+    const copy = JSON.parse(JSON.stringify(tf));
+    if (copy.domain === 'value') {
+      const [lo, hi] = copy.range || hello.volume.vis_range;
+      const norm = (x) => clamp((x - lo) / (hi - lo), 0, 1);
+      copy.color.forEach((p) => { p[0] = norm(p[0]); });
+      copy.opacity.forEach((p) => { p[0] = norm(p[0]); });
+      copy.domain = 'normalized';
+      copy.range = [lo, hi];
+    }
+    delete copy.description;
+    state.tf = copy;
+    selectedStop = -1;
+    drawTf();
+  }
+  function edited() {
+    state.tf.name = 'edited';
+    $('preset').value = '';
+  }
+
+  const PAD = 6;  // pixels around the plot, so end points stay grabbable
+  const plotW = () => tfCanvas.width - 2 * PAD, plotH = () => tfCanvas.height - 2 * PAD;
+  const toX = (x) => PAD + x * plotW();
+  const toY = (a) => PAD + (1 - a) * plotH();
+  const fromX = (px) => clamp((px - PAD) / plotW(), 0, 1);
+  const fromY = (py) => clamp(1 - (py - PAD) / plotH(), 0, 1);
+
+  // Canvas coordinates of opacity point i (tests drive the editor through these).
+  function opacityPointClient(i) {
+    const r = tfCanvas.getBoundingClientRect();
+    const p = state.tf.opacity[i];
+    return { x: r.left + toX(p[0]) * r.width / tfCanvas.width, y: r.top + toY(p[1]) * r.height / tfCanvas.height };
+  }
+
+  function colorAt(x) {
+    const c = state.tf.color;
+    if (x <= c[0][0]) return c[0].slice(1);
+    for (let i = 1; i < c.length; i++) {
+      if (x <= c[i][0]) {
+        const t = c[i][0] > c[i - 1][0] ? (x - c[i - 1][0]) / (c[i][0] - c[i - 1][0]) : 1;
+        return [1, 2, 3].map((k) => c[i - 1][k] + t * (c[i][k] - c[i - 1][k]));
+      }
+    }
+    return c[c.length - 1].slice(1);
+  }
+  const css = (rgb) => `rgb(${rgb.map((v) => Math.round(255 * v)).join(',')})`;
+
+  function drawTf() {
+    if (!state.tf || !hello) return;
+    const g = tfCanvas.getContext('2d');
+    const W = tfCanvas.width, H = tfCanvas.height;
+    g.clearRect(0, 0, W, H);
+    // Histogram of the volume over the visualization range.
+    const hist = hello.histogram;
+    const log = $('logscale').checked;
+    const f = (v) => (log ? Math.log1p(v) : v);
+    const peak = Math.max(1, ...hist.map(f));
+    g.fillStyle = '#3a3f48';
+    const bw = plotW() / hist.length;
+    hist.forEach((v, i) => {
+      const h = (f(v) / peak) * plotH();
+      g.fillRect(PAD + i * bw, PAD + plotH() - h, Math.max(1, bw), h);
+    });
+    // Opacity curve, filled with the TF's colour.
+    const op = state.tf.opacity;
+    const grad = g.createLinearGradient(PAD, 0, PAD + plotW(), 0);
+    for (let k = 0; k <= 16; k++) grad.addColorStop(k / 16, css(colorAt(k / 16)));
+    g.beginPath();
+    g.moveTo(toX(0), toY(0));
+    g.lineTo(toX(0), toY(op[0][1]));
+    for (const p of op) g.lineTo(toX(p[0]), toY(p[1]));
+    g.lineTo(toX(1), toY(op[op.length - 1][1]));
+    g.lineTo(toX(1), toY(0));
+    g.closePath();
+    g.globalAlpha = 0.45;
+    g.fillStyle = grad;
+    g.fill();
+    g.globalAlpha = 1;
+    g.strokeStyle = '#eee';
+    g.lineWidth = 1.5;
+    g.beginPath();
+    op.forEach((p, i) => (i ? g.lineTo(toX(p[0]), toY(p[1])) : g.moveTo(toX(p[0]), toY(p[1]))));
+    g.stroke();
+    op.forEach((p, i) => {
+      g.beginPath();
+      g.arc(toX(p[0]), toY(p[1]), 4.5, 0, 2 * Math.PI);
+      g.fillStyle = i === dragPoint ? '#fc6' : '#fff';
+      g.fill();
+      g.strokeStyle = '#000';
+      g.stroke();
+    });
+    drawColors();
+  }
+
+  function drawColors() {
+    const g = colorCanvas.getContext('2d');
+    const W = colorCanvas.width, H = colorCanvas.height;
+    g.clearRect(0, 0, W, H);
+    for (let px = 0; px < plotW(); px++) {
+      g.fillStyle = css(colorAt(px / (plotW() - 1)));
+      g.fillRect(PAD + px, 0, 1, H - 9);
+    }
+    state.tf.color.forEach((c, i) => {
+      const x = toX(c[0]);
+      g.beginPath();
+      g.moveTo(x, H - 10);
+      g.lineTo(x - 5, H - 1);
+      g.lineTo(x + 5, H - 1);
+      g.closePath();
+      g.fillStyle = css(c.slice(1));
+      g.fill();
+      g.strokeStyle = i === selectedStop ? '#fc6' : '#aaa';
+      g.lineWidth = i === selectedStop ? 2 : 1;
+      g.stroke();
+    });
+  }
+
+  const canvasPos = (canvas, e) => {
+    const r = canvas.getBoundingClientRect();
+    return { x: (e.clientX - r.left) * canvas.width / r.width, y: (e.clientY - r.top) * canvas.height / r.height };
+  };
+  function nearestPoint(points, pos, useY) {
+    let best = -1, bestD = 9;  // pixels
+    points.forEach((p, i) => {
+      const d = useY ? Math.hypot(toX(p[0]) - pos.x, toY(p[1]) - pos.y) : Math.abs(toX(p[0]) - pos.x);
+      if (d <= bestD) { best = i; bestD = d; }
+    });
+    return best;
+  }
+
+  // Opacity points: drag to move (x stays between the neighbours), double-click to add or remove.
+  let dragPoint = -1;
+  tfCanvas.addEventListener('pointerdown', (e) => {
+    if (!state.tf) return;
+    const i = nearestPoint(state.tf.opacity, canvasPos(tfCanvas, e), true);
+    if (i < 0) return;
+    dragPoint = i;
+    interacting = true;
+    tfCanvas.setPointerCapture(e.pointerId);
+    drawTf();
+  });
+  tfCanvas.addEventListener('pointermove', (e) => {
+    if (dragPoint < 0) return;
+    const pos = canvasPos(tfCanvas, e), op = state.tf.opacity, i = dragPoint;
+    const lo = i > 0 ? op[i - 1][0] : 0, hi = i < op.length - 1 ? op[i + 1][0] : 1;
+    op[i] = [round4(clamp(fromX(pos.x), lo, hi)), round4(fromY(pos.y))];
+    edited();
+    drawTf();
+    request(true);
+  });
+  const endDrag = () => {
+    if (dragPoint < 0) return;
+    dragPoint = -1;
+    interacting = false;
+    drawTf();
+    request(false);
+  };
+  tfCanvas.addEventListener('pointerup', endDrag);
+  tfCanvas.addEventListener('pointercancel', endDrag);
+  tfCanvas.addEventListener('dblclick', (e) => {
+    const pos = canvasPos(tfCanvas, e), op = state.tf.opacity;
+    const i = nearestPoint(op, pos, true);
+    if (i >= 0) {
+      if (op.length > 1) op.splice(i, 1);
+    } else {
+      const x = round4(fromX(pos.x));
+      if (op.filter((p) => p[0] === x).length >= 2) return;  // at most two points share an x
+      let at = op.findIndex((p) => p[0] > x);
+      if (at < 0) at = op.length;
+      op.splice(at, 0, [x, round4(fromY(pos.y))]);
+    }
+    edited();
+    drawTf();
+    request(false);
+  });
+
+  // Colour stops: click selects (the colour input edits it), drag moves, double-click adds.
+  let dragStop = -1;
+  colorCanvas.addEventListener('pointerdown', (e) => {
+    const i = nearestPoint(state.tf.color, canvasPos(colorCanvas, e), false);
+    if (i < 0) return;
+    selectedStop = dragStop = i;
+    const c = state.tf.color[i];
+    $('stop-color').value = '#' + c.slice(1).map((v) => Math.round(255 * v).toString(16).padStart(2, '0')).join('');
+    colorCanvas.setPointerCapture(e.pointerId);
+    interacting = true;
+    drawColors();
+  });
+  colorCanvas.addEventListener('pointermove', (e) => {
+    if (dragStop < 0) return;
+    const c = state.tf.color, i = dragStop;
+    const lo = i > 0 ? c[i - 1][0] : 0, hi = i < c.length - 1 ? c[i + 1][0] : 1;
+    c[i][0] = round4(clamp(fromX(canvasPos(colorCanvas, e).x), lo, hi));
+    edited();
+    drawTf();
+    request(true);
+  });
+  const endStop = () => {
+    if (dragStop < 0) return;
+    dragStop = -1;
+    interacting = false;
+    request(false);
+  };
+  colorCanvas.addEventListener('pointerup', endStop);
+  colorCanvas.addEventListener('pointercancel', endStop);
+  colorCanvas.addEventListener('dblclick', (e) => {
+    const x = round4(fromX(canvasPos(colorCanvas, e).x)), c = state.tf.color;
+    if (nearestPoint(c, canvasPos(colorCanvas, e), false) >= 0) return;
+    let at = c.findIndex((p) => p[0] > x);
+    if (at < 0) at = c.length;
+    c.splice(at, 0, [x, ...colorAt(x).map(round4)]);
+    selectedStop = at;
+    edited();
+    drawTf();
+    request(false);
+  });
+  $('stop-color').addEventListener('input', (e) => {
+    if (selectedStop < 0) return;
+    const v = e.target.value;
+    const rgb = [1, 3, 5].map((k) => round4(parseInt(v.slice(k, k + 2), 16) / 255));
+    state.tf.color[selectedStop] = [state.tf.color[selectedStop][0], ...rgb];
+    edited();
+    drawTf();
+    request(true);
+  });
+  $('stop-remove').addEventListener('click', () => {
+    if (selectedStop < 0 || state.tf.color.length <= 1) return;
+    state.tf.color.splice(selectedStop, 1);
+    selectedStop = -1;
+    edited();
+    drawTf();
+    request(false);
+  });
+
+  function clamp(v, lo, hi) { return Math.min(hi, Math.max(lo, v)); }
+  function round4(v) { return Math.round(v * 10000) / 10000; }
+
+  // A small handle for scripts and tests (tests/e2e/viewer.e2e.mjs).
+  window.lacunaViewer = { state, opacityPointClient, frames: () => frames };
+  connect();
+})();
