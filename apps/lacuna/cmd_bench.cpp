@@ -37,6 +37,8 @@ struct FaludiArgs {
     int tf_repeats = 3;
     bool no_ideal = false;
     bool size_given = false, views_given = false;
+    std::string rows = "marching,early-exit";  // --rows: also shading, lighting
+    float shadow_step = 1.f;
 };
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -112,6 +114,11 @@ void run_table(const FaludiArgs& a, const bench::OrbitSpec& orbit, const AccelOp
     fo.threads = a.threads;
     fo.tf_repeats = a.tf_repeats;
     fo.ideal = !a.no_ideal;
+    fo.modes.clear();
+    for (const std::string& n : split_list(a.rows)) fo.modes.push_back(bench::parse_row_mode(n));
+    if (!(a.shadow_step > 0.f && a.shadow_step <= 64.f))
+        throw Error("--shadow-step", "step", "expected 0 < step <= 64");
+    fo.shadow_step = a.shadow_step;
     const auto ids = parse_datasets(a.datasets, "--datasets");
     bench::RunInfo info = bench::collect_run_info(command_line());
     std::printf("lacuna bench faludi: %dx%d, %d views, %zu datasets, %s, %d threads\n", orbit.size,
@@ -271,6 +278,12 @@ void register_bench(CLI::App& app) {
     f->add_option("--tf-repeats", a->tf_repeats, "TF changes timed per structure (median)")
         ->capture_default_str();
     f->add_flag("--no-ideal", a->no_ideal, "Skip the ideal-speedup sample count");
+    f->add_option("--rows", a->rows,
+                  "Comma-separated rows: marching, early-exit, shading (+ PBR shading), lighting "
+                  "(+ spotlight with shadow rays)")
+        ->capture_default_str();
+    f->add_option("--shadow-step", a->shadow_step, "Shadow-ray sample distance of the lighting row")
+        ->capture_default_str();
     f->callback([a, f] {
         a->size_given = f->count("--size") > 0;
         a->views_given = f->count("--views") > 0;

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "cli_common.h"
+#include "feature_args.h"
 #include "render_slice.h"
 #include "core/parallel.h"
 #include "lacuna/accel.h"
@@ -42,6 +43,7 @@ struct RenderArgs {
     int leaf = 8, bits = 64, initial_level = -1;
     bool top_down = false;
     std::string background = "0,0,0";
+    FeatureArgs features;  // shading, lights, clipping, blend modes (feature_args.h)
     SegmentArgs segments;
     SliceCliArgs slice;  // --renderer, --occlusion* (render_slice.h)
 };
@@ -112,6 +114,9 @@ Setup validate(RenderArgs& a) {
     s.ro.threads = a.threads;
     s.ro.background = parse_rgb(a.background);
     s.ro.count_samples = !a.heatmap.empty();
+    s.ro.features = parse_features(a.features);
+    if (!a.tf_animate.empty() && !a.features.tf_back.empty())
+        throw Error("--tf-back", "transfer function", "not supported with --tf-animate");
     s.ao.leaf_cells = a.leaf;
     s.ao.bitfield_bits = a.bits;
     s.ao.initial_level = a.initial_level;
@@ -146,9 +151,16 @@ void render_one(const RenderArgs& a, const Setup& s) {
     const Volume vol = load_volume(a.volume);
     const TransferLut lut = discretise(tf, vol.vis_range());
     auto accel = build_accel(kind, vol, s.ao);
-    accel->set_transfer_function(lut);
     RayMarcher marcher(vol);
     marcher.set_transfer_function(lut);
+    if (a.features.tf_back.empty()) {
+        accel->set_transfer_function(lut);
+    } else {
+        // Two TFs: the structure skips only where both are transparent.
+        const TransferLut back = discretise(resolve_transfer_function(a.features.tf_back), vol.vis_range());
+        marcher.set_back_transfer_function(back);
+        accel->set_transfer_function(union_lut(lut, back));
+    }
     marcher.set_accel(accel.get());
     const Camera cam = Camera::orbit(marcher.bounds(), s.op, s.w, s.h);
     const RenderResult r = marcher.render(cam, s.ro);
@@ -158,6 +170,15 @@ void render_one(const RenderArgs& a, const Setup& s) {
                 a.ortho ? "orthographic" : "perspective", tf.name.c_str(), a.accel.c_str(),
                 resolve_threads(a.threads));
     print_accel(kind, *accel);
+    if (const std::string f = describe(s.ro.features); !f.empty()) std::printf("features: %s\n", f.c_str());
+    if (r.stats.gradient_volume_bytes)
+        std::printf("gradient volume: %.2f MiB, computed in %.1f ms\n",
+                    double(r.stats.gradient_volume_bytes) / (1 << 20), r.stats.gradient_volume_seconds * 1e3);
+    if (r.stats.light_volume_bytes)
+        std::printf("light volume: %.2f MiB, computed in %.1f ms (part of the render time)\n",
+                    double(r.stats.light_volume_bytes) / (1 << 20), r.stats.light_volume_seconds * 1e3);
+    if (r.stats.shadow_samples)
+        std::printf("shadow samples: %.1f per ray\n", double(r.stats.shadow_samples) / double(std::max<uint64_t>(r.stats.rays, 1)));
     std::printf("render time %.1f ms, %.1f samples/ray, %.1f Msamples/s (%.1f per thread)\n",
                 r.stats.seconds * 1e3, r.stats.samples_per_ray(), r.stats.msamples_per_second(),
                 r.stats.msamples_per_second() / resolve_threads(a.threads));
@@ -214,6 +235,13 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 void run(RenderArgs& a) {
     const Setup s = validate(a);
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
+    // Shading, lights, clipping, blend modes and jitter live in the ray marcher's feature kernel.
+    if (s.ro.features.any() || !a.features.tf_back.empty()) {
+        if (a.segments.active())
+            throw Error("--shading/--clip/--blend", "segments", "not available with --labels/--segments");
+        if (a.slice.renderer == "slice")
+            throw Error("--renderer", "slice", "shading, lights, clipping, blend modes and jitter need the ray marcher");
+    }
     if (a.segments.active()) {
         if (!a.tf_animate.empty())
             throw Error("--tf-animate", "segments", "not available with --labels/--segments");
@@ -276,6 +304,7 @@ void register_render(CLI::App& app) {
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--background", a->background, "Background colour R,G,B in [0,1]")
         ->capture_default_str();
+    add_feature_args(*cmd, a->features);
     add_segment_args(*cmd, a->segments);
     add_slice_options(*cmd, a->slice);
     cmd->callback([a, cmd] {

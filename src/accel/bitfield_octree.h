@@ -33,6 +33,26 @@ public:
         return hit == 0;
     }
     using Cursor = RegionCursor<BitfieldOctree>;
+    // MIP/MinIP skipping (src/accel/entry_window.h): empty when no cell of the node can produce
+    // a sample whose LUT entry lies in [lo, hi], i.e. the node has no bin of bin(lo)..bin(hi).
+    Region region_outside(const int cell[3], int& hint, int lo, int hi) const {
+        uint64_t mask[2] = {0, 0};
+        if (lo <= hi) {
+            const int b0 = bin(std::max(lo, 0)), b1 = bin(std::min(hi, m_lut_size - 1));
+            for (int w = 0; w < 2; ++w) {
+                const int a = std::max(b0 - 64 * w, 0), b = std::min(b1 - 64 * w, 63);
+                if (a > b) continue;
+                const uint64_t upto = b == 63 ? ~uint64_t(0) : (uint64_t(1) << (b + 1)) - 1;
+                mask[w] = upto & ~((uint64_t(1) << a) - 1);
+            }
+        }
+        return octree_region(m_pyr, cell, hint, m_start, m_opts.bidirectional, [&](size_t i) {
+            const uint64_t* w = &m_bits[i * size_t(m_words)];
+            uint64_t hit = w[0] & mask[0];
+            if (m_words == 2) hit |= w[1] & mask[1];
+            return hit == 0;
+        });
+    }
     int bits() const { return m_nbits; }
     // The TF bitfield (tests, the viewer's overlay).
     const uint64_t* tf_bits() const { return m_tf; }

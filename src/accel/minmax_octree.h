@@ -26,6 +26,13 @@ public:
         });
     }
     using Cursor = RegionCursor<MinMaxOctree>;
+    // Region maximum/minimum query for MIP and MinIP skipping (src/accel/entry_window.h): empty
+    // when no cell of the node can produce a sample whose LUT entry lies in [lo, hi].
+    Region region_outside(const int cell[3], int& hint, int lo, int hi) const {
+        return octree_region(m_pyr, cell, hint, m_start, m_opts.bidirectional, [&](size_t i) {
+            return int(m_nodes[i].hi) < lo || int(m_nodes[i].lo) > hi;
+        });
+    }
 
 private:
     void build();

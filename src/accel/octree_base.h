@@ -11,6 +11,8 @@ class OctreeBase : public Accel {
 public:
     const int* cells() const { return m_pyr.cells; }
     const Pyramid& pyramid() const { return m_pyr; }
+    // The value -> LUT entry map the structure's ranges are in (that of the last TF).
+    const ValueToLut& value_map() const { return m_map; }
 
 protected:
     OctreeBase(AccelKind k, const Volume& v, const AccelOptions& o) : Accel(k), m_volume(v), m_opts(o) {

@@ -23,12 +23,8 @@ std::string fmt(const char* f, double a) {
     return buf;
 }
 
-RenderOptions render_options(const FaludiOptions& o, RowMode m) {
-    RenderOptions ro;
-    ro.step = o.step;
-    ro.ert = m == RowMode::EarlyExit ? o.ert : 2.f;
-    ro.threads = o.threads;
-    return ro;
+RenderOptions render_options(const FaludiOptions& o, RowMode m, const Box3f& bounds) {
+    return row_render_options(o, m, bounds);
 }
 
 // Builds a structure and times its TF changes.
@@ -106,14 +102,14 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
     for (RowMode mode : o.modes) {
         RowResult row;
         row.mode = mode;
-        row.ert = render_options(o, mode).ert;
+        row.ert = render_options(o, mode, m.bounds()).ert;
         out.rows.push_back(row);
     }
     out.structures.push_back(StructureResult{});
     for (RowResult& row : out.rows) {
         if (log) log("  " + d.name + " " + to_string(row.mode) + " none ...");
         reference.push_back(Image{});
-        CellResult c = run_cell(AccelKind::None, m, cams, render_options(o, row.mode), nullptr,
+        CellResult c = run_cell(AccelKind::None, m, cams, render_options(o, row.mode, m.bounds()), nullptr,
                                 &reference.back());
         c.exact = true;
         c.speedup = c.sample_reduction = 1;
@@ -128,7 +124,18 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
         if (o.ideal) {
             for (RowResult& row : out.rows) {
                 const auto t1 = std::chrono::steady_clock::now();
-                const RenderOptions ro = render_options(o, row.mode);
+                const RenderOptions ro = render_options(o, row.mode, m.bounds());
+                // Shading and lighting change what a sample costs, not which samples a ray
+                // takes: their ideal is that of the early-exit row.
+                const RowResult* same = nullptr;
+                for (const RowResult& other : out.rows)
+                    if (&other != &row && other.ert == row.ert && other.ideal_samples &&
+                        other.mode == RowMode::EarlyExit)
+                        same = &other;
+                if (same && row.mode != RowMode::EarlyExit) {
+                    row.ideal_samples = same->ideal_samples;
+                    continue;
+                }
                 for (const Camera& cam : cams)
                     row.ideal_samples +=
                         count_visible_cell_samples(*d.volume, d.lut, cells, cam, ro);
@@ -165,7 +172,7 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
         m.set_accel(accel.get());
         for (size_t r = 0; r < out.rows.size(); ++r) {
             RowResult& row = out.rows[r];
-            CellResult c = run_cell(k, m, cams, render_options(o, row.mode), &reference[r]);
+            CellResult c = run_cell(k, m, cams, render_options(o, row.mode, m.bounds()), &reference[r]);
             const CellResult& none = row.cells[0];
             c.speedup = c.frame_ms.mean > 0 ? none.frame_ms.mean / c.frame_ms.mean : 0;
             c.sample_reduction = c.samples ? double(none.samples) / double(c.samples) : 0;
@@ -183,7 +190,54 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
 }  // namespace
 
 std::string to_string(RowMode m) {
-    return m == RowMode::MarchingOnly ? "Marching only" : "+ Early exit";
+    switch (m) {
+        case RowMode::MarchingOnly: return "Marching only";
+        case RowMode::EarlyExit: return "+ Early exit";
+        case RowMode::Shading: return "+ Shading";
+        case RowMode::Lighting: return "+ Lighting";
+    }
+    return "?";
+}
+
+std::string csv_name(RowMode m) {
+    switch (m) {
+        case RowMode::MarchingOnly: return "marching_only";
+        case RowMode::EarlyExit: return "early_exit";
+        case RowMode::Shading: return "shading";
+        case RowMode::Lighting: return "lighting";
+    }
+    return "?";
+}
+
+RowMode parse_row_mode(const std::string& name) {
+    if (name == "marching") return RowMode::MarchingOnly;
+    if (name == "early-exit") return RowMode::EarlyExit;
+    if (name == "shading") return RowMode::Shading;
+    if (name == "lighting") return RowMode::Lighting;
+    throw Error("--rows", "row", "unknown '" + name + "'; expected one of: marching, early-exit, shading, lighting");
+}
+
+RenderOptions row_render_options(const FaludiOptions& o, RowMode m, const Box3f& bounds) {
+    RenderOptions ro;
+    ro.step = o.step;
+    ro.ert = m == RowMode::MarchingOnly ? 2.f : o.ert;
+    ro.threads = o.threads;
+    if (m == RowMode::Shading || m == RowMode::Lighting) {
+        // The paper's model (Section 4.4): Disney diffuse, GGX, Smith joint GGX, Schlick.
+        ro.features.shading = ShadingModel::Pbr;
+    }
+    if (m == RowMode::Lighting) {
+        // One spotlight above, in front and to the left of the volume, aimed at its centre,
+        // with shadow rays from every shaded sample through the structure.
+        const Vec3f c = bounds.center(), e = bounds.extent();
+        ro.features.light.kind = LightKind::Spot;
+        ro.features.light.position = c + Vec3f{-0.8f * e.x, 1.2f * e.y, 1.0f * e.z};
+        ro.features.light.target = c;
+        ro.features.light.cone_deg = 40.f;
+        ro.features.shadows.enabled = true;
+        ro.features.shadows.step = o.shadow_step;
+    }
+    return ro;
 }
 
 std::string to_string(TargetStatus s) {
@@ -264,7 +318,7 @@ bool is_large(const DatasetResult& d) {
 }
 
 std::string row_label(const DatasetResult& d, const RowResult& r) {
-    return d.name + " " + (r.mode == RowMode::MarchingOnly ? "marching" : "early-exit");
+    return d.name + " " + csv_name(r.mode);
 }
 
 // Worst row of f (lower is worse when `higher_is_better`), over the rows where f is defined.
@@ -303,6 +357,8 @@ std::vector<TargetCheck> check_targets(const FaludiReport& rep) {
         for (const RowResult& r : d.rows) {
             const CellResult* bf = r.find(AccelKind::Bitfield);
             if (!bf) continue;
+            // The targets are about skipping: the marching and early-exit rows.
+            if (r.mode == RowMode::Shading || r.mode == RowMode::Lighting) continue;
             if (r.ideal_speedup() > 0)
                 share.add(100 * r.share_of_ideal(AccelKind::Bitfield), row_label(d, r), true);
             if (is_large(d)) tree.add(bf->speedup, row_label(d, r), true);

@@ -14,18 +14,23 @@
 #include "bench/orbit.h"
 #include "bench/stats.h"
 #include "lacuna/accel.h"
+#include "lacuna/renderer.h"
 
 namespace lacuna::bench {
 
 using LogFn = std::function<void(const std::string&)>;
 
-// The paper's shader configurations that exist in lacuna (shading and lighting rows join when
-// shading exists).
+// The paper's shader configurations.
 enum class RowMode {
     MarchingOnly,  // early ray termination off (RenderOptions::ert = 2, never reached)
     EarlyExit,     // early ray termination at FaludiOptions::ert
+    Shading,       // + the paper's PBR shading (on-the-fly gradients) with a headlight
+    Lighting,      // + a spotlight with shadow rays through the structure (src/bench/faludi.cpp)
 };
-std::string to_string(RowMode m);  // "Marching only", "+ Early exit"
+std::string to_string(RowMode m);  // "Marching only", "+ Early exit", "+ Shading", "+ Lighting"
+std::string csv_name(RowMode m);   // "marching_only", "early_exit", "shading", "lighting"
+// Parses "marching", "early-exit", "shading", "lighting"; throws lacuna::Error("--rows", ...).
+RowMode parse_row_mode(const std::string& name);
 
 struct FaludiOptions {
     OrbitSpec orbit;
@@ -37,7 +42,12 @@ struct FaludiOptions {
     int threads = 0;     // render and build threads (0 = all)
     int tf_repeats = 3;  // TF changes timed per structure (the median is reported)
     bool ideal = true;   // count visible-cell samples (the ideal speedup)
+    float shadow_step = 1.f;  // '+ Lighting': shadow-ray sample distance (smallest spacings)
 };
+
+// The render options of a row for a volume with world box `bounds` (the '+ Lighting' spotlight
+// is placed relative to it).
+RenderOptions row_render_options(const FaludiOptions& o, RowMode m, const Box3f& bounds);
 
 struct CellResult {
     AccelKind kind = AccelKind::None;

@@ -308,7 +308,7 @@ std::string faludi_csv(const FaludiReport& rep) {
                     "%.4f,%.4f,%llu,%.4f,%.4f,%s,%.4f,%.4f,%.6f,%zu,%zu\n",
                     d.name.c_str(), d.description.c_str(), d.dims.x, d.dims.y, d.dims.z,
                     lacuna::to_string(d.type).c_str(), d.tf_name.c_str(),
-                    r.mode == RowMode::MarchingOnly ? "marching_only" : "early_exit", r.ert,
+                    csv_name(r.mode).c_str(), r.ert,
                     to_string(c.kind).c_str(), o.orbit.size, o.orbit.views, c.frame_ms.mean,
                     c.frame_ms.p99, c.frame_ms.min, c.frame_ms.max, (unsigned long long)c.samples,
                     (unsigned long long)c.rays, c.samples_per_ray(), c.speedup, c.sample_reduction,

@@ -7,6 +7,7 @@
 #include "accel/accel_impl.h"
 #include "core/parallel.h"
 #include "lacuna/error.h"
+#include "render/marcher_cache.h"
 #include "render/ray_march_kernel.h"
 
 namespace lacuna {
@@ -30,10 +31,56 @@ std::vector<Rgba> step_corrected_lut(const TransferLut& lut, float step) {
     return out;
 }
 
-RayMarcher::RayMarcher(const Volume& volume) : m_volume(volume) {}
+RayMarcher::RayMarcher(const Volume& volume) : m_volume(volume), m_cache(std::make_unique<Cache>()) {}
 RayMarcher::~RayMarcher() = default;
 
-void RayMarcher::set_transfer_function(const TransferLut& lut) { m_lut = lut; }
+void RayMarcher::set_transfer_function(const TransferLut& lut) {
+    m_lut = lut;
+    ++m_tf_version;
+}
+
+void RayMarcher::set_back_transfer_function(const TransferLut& lut) {
+    m_back_lut = lut;
+    ++m_tf_version;
+}
+
+std::string to_string(ShadingModel m) {
+    switch (m) {
+        case ShadingModel::None: return "none";
+        case ShadingModel::Phong: return "phong";
+        case ShadingModel::Pbr: return "pbr";
+    }
+    return "?";
+}
+
+std::string to_string(LightKind k) {
+    switch (k) {
+        case LightKind::Head: return "head";
+        case LightKind::Directional: return "directional";
+        case LightKind::Spot: return "spot";
+    }
+    return "?";
+}
+
+std::string to_string(BlendMode m) {
+    switch (m) {
+        case BlendMode::Composite: return "composite";
+        case BlendMode::Mip: return "mip";
+        case BlendMode::MinIp: return "minip";
+        case BlendMode::Average: return "average";
+    }
+    return "?";
+}
+
+TransferLut union_lut(const TransferLut& a, const TransferLut& b) {
+    if (a.size() != b.size() || a.vis.min != b.vis.min || a.vis.max != b.vis.max)
+        throw Error("--tf-back", "transfer function",
+                    "expected the same LUT size and visualization range as --tf");
+    TransferLut u = a;
+    for (size_t e = 0; e < u.entries.size(); ++e)
+        u.entries[e].a = std::max(a.entries[e].a, b.entries[e].a);
+    return u;
+}
 
 Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; }
 
@@ -119,6 +166,7 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
         throw Error("--step", "step", "expected a positive number");
     if (cam.width() < 1 || cam.height() < 1)
         throw Error("--size", "image size", "expected at least 1x1 pixels");
+    if (opt.features.any()) return render_features(cam, opt);
     RenderResult out;
     out.image = Image(cam.width(), cam.height());
     if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);

@@ -1,0 +1,425 @@
+// The feature kernel: the ray marcher's sample loop with shading, gradient opacity, lights and
+// shadow rays, clip planes, a crop box, two TFs split by a plane, MIP / MinIP / average blending
+// and jittered ray starts (docs/shading.md). The features-off path stays the fast kernel of
+// render/ray_march_kernel.h; this one is scalar, one sample at a time, and runs only when a
+// feature is on (RenderOptions::features.any()).
+//
+// Exactness (docs/architecture.md, invariant 1) holds per feature:
+//  - Every sample the structure may drop has TF opacity exactly 0 on its side of the split plane
+//    (the structure is given union_lut(front, back)). Such a sample contributes nothing here
+//    either: it is tested (`raw.a > 0`) and left out before any shading, so the kept samples and
+//    their order - hence every float operation - are those of the unaccelerated ray.
+//  - Gradient opacity multiplies the TF opacity: zero stays zero. Gradients read a neighbourhood
+//    of the sample (+-1 voxel) but are only evaluated for samples that are kept anyway.
+//  - Shadow rays march the same structure with their own lattice from the sample toward the
+//    light and drop only zero-opacity samples, so their transmittance is bit-identical to the
+//    unaccelerated shadow ray's (ShadowOptions::accelerate = false).
+//  - Clip planes and the crop box remove samples by a per-sample test of the same position in
+//    both paths; they never change which samples a structure may skip.
+//  - MIP / MinIP skip through src/accel/entry_window.h (exact by its own argument); average
+//    averages the values of samples with non-zero TF opacity, so zero-opacity samples may go.
+//  - Jitter shifts the lattice per pixel by the same amount in both paths.
+#pragma once
+#include <algorithm>
+#include <atomic>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+
+#include "accel/cursor.h"
+#include "accel/entry_window.h"
+#include "accel/no_accel.h"
+#include "core/parallel.h"
+#include "lacuna/camera.h"
+#include "lacuna/image.h"
+#include "lacuna/renderer.h"
+#include "render/ray_march_kernel.h"
+#include "render/shading.h"
+
+namespace lacuna::feature {
+
+// A half-space in index space: kept when nx*x + ny*y + nz*z >= d.
+struct HalfSpace {
+    float nx = 0, ny = 0, nz = 0, d = 0;
+    bool inside(float x, float y, float z) const { return nx * x + ny * y + nz * z >= d; }
+};
+
+// World plane dot(n, p) >= d as an index-space half-space (p = index * spacing).
+inline HalfSpace to_index(const ClipPlane& p, Vec3f sp) {
+    return {p.normal.x * sp.x, p.normal.y * sp.y, p.normal.z * sp.z, p.d};
+}
+
+// A float grid sampled with the renderer's trilinear() (gradient and light volumes).
+inline kernel::Grid<float, int64_t> float_grid(const float* data, const int m[3]) {
+    return {data, ptrdiff_t(m[0]), ptrdiff_t(m[0]) * m[1], float(m[0] - 1), float(m[1] - 1),
+            float(m[2] - 1), m[0] - 2, m[1] - 2, m[2] - 2};
+}
+
+// Everything a feature sample needs, set up once per frame (src/render/ray_marcher.cpp).
+struct Context {
+    const FeatureOptions* f = nullptr;
+    // [side]: 0 = front TF, 1 = back TF (equal to front when there is no back TF).
+    const Rgba* raw[2] = {};          // straight colour, opacity per unit distance
+    const Rgba* corr[2] = {};         // step_corrected_lut(step)
+    const Rgba* shadow_corr[2] = {};  // step_corrected_lut(shadows.step)
+    ValueToLut map;
+    bool two_tfs = false;
+    HalfSpace split;                  // clip plane 0 when two_tfs
+    const HalfSpace* clips = nullptr; // the clipping half-spaces (plane 0 excluded when two_tfs)
+    int n_clips = 0;
+    float crop_lo[3] = {}, crop_hi[3] = {};  // index space
+    float step = 0.5f, dt = 0, dts = 0, ert = 2.f;
+    Vec3f sp{1, 1, 1}, inv_sp{1, 1, 1};
+    bool need_gradient = false;
+    const float* grad[3] = {};        // precomputed world gradient, or null: on the fly
+    const float* light = nullptr;     // light volume (transmittance), or null
+    int light_dims[3] = {0, 0, 0};
+    float inv_stride = 1.f;
+    Vec3f light_dir{0, 0, 1};         // directional: unit vector to the light
+    Vec3f spot_axis{0, 0, -1};        // spot: unit vector from the light to its target
+    int threads = 0;
+
+    bool kept(float x, float y, float z) const {
+        for (int i = 0; i < n_clips; ++i)
+            if (!clips[i].inside(x, y, z)) return false;
+        if (f->crop && !(x >= crop_lo[0] && x <= crop_hi[0] && y >= crop_lo[1] &&
+                         y <= crop_hi[1] && z >= crop_lo[2] && z <= crop_hi[2]))
+            return false;
+        return true;
+    }
+    int side(float x, float y, float z) const { return two_tfs && !split.inside(x, y, z) ? 1 : 0; }
+};
+
+// Deterministic per-pixel jitter in [0, 1) (a 32-bit integer hash of pixel and seed).
+inline float jitter(uint32_t x, uint32_t y, uint32_t seed) {
+    uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ (seed + 1u) * 0xcb1ab31fu;
+    h ^= h >> 16;
+    h *= 0x7feb352du;
+    h ^= h >> 15;
+    h *= 0x846ca68bu;
+    h ^= h >> 16;
+    return float(h >> 8) * (1.f / 16777216.f);
+}
+
+// Calls fn(k) for the lattice samples t_k = t_base + (k + 0.5)*dt, k < k_end, that lie in the
+// cursor's segments (rounded outward, as the fast kernel does), in order, each at most once,
+// until fn returns false.
+template <class Cursor, class Fn>
+inline void for_each_sample(Cursor& cursor, float t_base, float dt, int k_end, Fn&& fn) {
+    Segment seg;
+    int k = 0;
+    bool go = true;
+    while (go && k < k_end && cursor.next(seg)) {
+        const int kb = std::max(k, int(std::floor((seg.t0 - t_base) / dt - 0.5f)));
+        const int ke = std::min(k_end, int(std::floor((seg.t1 - t_base) / dt - 0.5f)) + 2);
+        for (int j = kb; j < ke && go; ++j) go = fn(j);
+        k = std::max(k, ke);
+    }
+}
+
+// World-space gradient (voxel values per mm) at index point (x,y,z).
+template <class T, class Index>
+inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x, float y, float z) {
+    if (c.grad[0]) {
+        const int m[3] = {int(g.hi_x) + 1, int(g.hi_y) + 1, int(g.hi_z) + 1};
+        return {kernel::trilinear(float_grid(c.grad[0], m), x, y, z),
+                kernel::trilinear(float_grid(c.grad[1], m), x, y, z),
+                kernel::trilinear(float_grid(c.grad[2], m), x, y, z)};
+    }
+    // Central differences of trilinear samples one voxel to either side (clamped at the box).
+    const float gx = (kernel::trilinear(g, x + 1.f, y, z) - kernel::trilinear(g, x - 1.f, y, z)) * 0.5f;
+    const float gy = (kernel::trilinear(g, x, y + 1.f, z) - kernel::trilinear(g, x, y - 1.f, z)) * 0.5f;
+    const float gz = (kernel::trilinear(g, x, y, z + 1.f) - kernel::trilinear(g, x, y, z - 1.f)) * 0.5f;
+    return {gx * c.inv_sp.x, gy * c.inv_sp.y, gz * c.inv_sp.z};
+}
+
+// Transmittance from index point (x,y,z) toward the light along world direction l (unit), up to
+// world distance t_max: a shadow ray on its own lattice t_k = (k + 0.5)*dts through the same
+// skipping structure (or every sample when !accelerate), opacity from the shadow-step LUT of
+// each sample's side, clipped samples transparent, early termination at the frame's ert.
+template <class T, class Index, class S>
+float transmittance(const Context& c, const kernel::Grid<T, Index>& g, const S& accel, float x,
+                    float y, float z, Vec3f l, float t_max, uint64_t& n) {
+    const kernel::IndexRay r{x, y, z, l.x * c.inv_sp.x, l.y * c.inv_sp.y, l.z * c.inv_sp.z};
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
+    float t0, t1;
+    if (!kernel::intersect_box(r, hi, t0, t1)) return 1.f;
+    t1 = std::min(t1, t_max);
+    const int k_end = std::max(int(std::ceil(t1 / c.dts - 0.5f)), 0);
+    float a = 0.f;
+    auto fn = [&](int k) {
+        const float t = (float(k) + 0.5f) * c.dts;
+        const float qx = r.ox + t * r.dx, qy = r.oy + t * r.dy, qz = r.oz + t * r.dz;
+        if (!c.kept(qx, qy, qz)) return true;
+        ++n;
+        const float as = c.shadow_corr[c.side(qx, qy, qz)][c.map(kernel::trilinear(g, qx, qy, qz))].a;
+        if (as > 0.f) {
+            a += (1.f - a) * as;
+            if (a >= c.ert) return false;
+        }
+        return true;
+    };
+    const CursorRay cr{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}};
+    const float chunk = c.ert < 1.f ? 16.f * c.dts : 0.f;
+    if (c.f->shadows.accelerate) {
+        typename S::Cursor cursor(accel, cr, 0.f, t1, c.dts, chunk);
+        for_each_sample(cursor, 0.f, c.dts, k_end, fn);
+    } else {
+        static const NoAccel kNone;
+        NoAccel::Cursor cursor(kNone, cr, 0.f, t1);
+        for_each_sample(cursor, 0.f, c.dts, k_end, fn);
+    }
+    return 1.f - a;
+}
+
+// The light at a sample: direction l to it, its intensity li there (spot falloff applied) and
+// the distance to it (infinite for directional lights). `view` is the unit vector to the eye.
+inline void light_at(const Context& c, Vec3f pw, Vec3f view, Vec3f& l, float& li, float& dist) {
+    const Light& L = c.f->light;
+    li = L.intensity;
+    dist = INFINITY;
+    switch (L.kind) {
+        case LightKind::Head: l = view; break;
+        case LightKind::Directional: l = c.light_dir; break;
+        case LightKind::Spot: {
+            const Vec3f d = L.position - pw;
+            dist = length(d);
+            l = dist > 0.f ? d / dist : c.spot_axis * -1.f;
+            li *= shading::spot_factor(-dot(l, c.spot_axis), L.cone_deg);
+            break;
+        }
+    }
+}
+
+// The light volume: transmittance toward the light at every stride-th voxel (index points
+// (i,j,k)*stride clamped into the box), computed with shadow rays through the structure.
+// `l_fixed` is the light direction for head and directional lights.
+template <class T, class Index, class S>
+void build_light_volume(const Context& c, const kernel::Grid<T, Index>& g, const S& accel,
+                        Vec3f l_fixed, float stride, float* out, std::atomic<uint64_t>& samples) {
+    const int* m = c.light_dims;
+    parallel_for(size_t(m[2]), c.threads, [&](size_t z0, size_t z1) {
+        uint64_t n = 0;
+        for (size_t k = z0; k < z1; ++k)
+            for (int j = 0; j < m[1]; ++j)
+                for (int i = 0; i < m[0]; ++i) {
+                    const float x = std::min(float(i) * stride, g.hi_x),
+                                y = std::min(float(j) * stride, g.hi_y),
+                                z = std::min(float(k) * stride, g.hi_z);
+                    Vec3f l = l_fixed;
+                    float t_max = INFINITY;
+                    if (c.f->light.kind == LightKind::Spot) {
+                        const Vec3f d = c.f->light.position - Vec3f{x, y, z} * c.sp;
+                        t_max = length(d);
+                        l = t_max > 0.f ? d / t_max : c.spot_axis * -1.f;
+                    }
+                    out[(k * size_t(m[1]) + size_t(j)) * size_t(m[0]) + size_t(i)] =
+                        transmittance(c, g, accel, x, y, z, l, t_max, n);
+                }
+        samples += n;
+    });
+}
+
+// Per-tile counters.
+struct Counts {
+    uint64_t samples = 0, rays = 0, shadow = 0;
+};
+
+// Composite: the shaded, lit, clipped emission-absorption ray. Returns the samples taken.
+template <class T, class Index, class S, class Cursor>
+inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g, const S& accel,
+                              Cursor& cursor, const kernel::IndexRay& r, Vec3f view, float t_base,
+                              int k_end, kernel::Accum& acc, uint64_t& shadow_n) {
+    const FeatureOptions& f = *c.f;
+    uint32_t n = 0;
+    for_each_sample(cursor, t_base, c.dt, k_end, [&](int k) {
+        // 1. Position; clipped samples are not taken.
+        const float t = t_base + (float(k) + 0.5f) * c.dt;
+        const float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
+        if (!c.kept(x, y, z)) return true;
+        // 2. The TF of this side; zero opacity contributes nothing (and may be skipped).
+        const int s = c.side(x, y, z);
+        const int e = c.map(kernel::trilinear(g, x, y, z));
+        ++n;
+        const Rgba& raw = c.raw[s][e];
+        if (!(raw.a > 0.f)) return true;
+        float a = c.corr[s][e].a;
+        Vec3f rgb{raw.r, raw.g, raw.b};
+        // 3. Gradient: opacity modulation, then shading.
+        if (c.need_gradient) {
+            const Vec3f grad = gradient(c, g, x, y, z);
+            if (f.gradient_opacity.enabled) {
+                const float am = std::min(raw.a, 1.f) *
+                                 shading::gradient_opacity(f.gradient_opacity, length(grad));
+                if (!(am > 0.f)) return true;
+                a = 1.f - std::pow(1.f - am, c.step);
+            }
+            Vec3f nrm;
+            if (f.shading != ShadingModel::None && shading::normal_from_gradient(grad, view, nrm)) {
+                const Vec3f pw = Vec3f{x, y, z} * c.sp;
+                Vec3f l;
+                float li, dist;
+                light_at(c, pw, view, l, li, dist);
+                if (f.shadows.enabled && li > 0.f) {
+                    if (c.light)
+                        li *= kernel::trilinear(float_grid(c.light, c.light_dims), x * c.inv_stride,
+                                                y * c.inv_stride, z * c.inv_stride);
+                    else
+                        li *= transmittance(c, g, accel, x, y, z, l, dist, shadow_n);
+                }
+                rgb = f.shading == ShadingModel::Phong ? shading::phong(f.phong, rgb, nrm, l, view, li)
+                                                       : shading::pbr(f.pbr, rgb, nrm, l, view, li);
+            }
+        }
+        if (f.shading == ShadingModel::None && f.shadows.enabled) {
+            // Unshaded but lit: the TF colour times the light reaching the sample.
+            const Vec3f pw = Vec3f{x, y, z} * c.sp;
+            Vec3f l;
+            float li, dist;
+            light_at(c, pw, view, l, li, dist);
+            if (li > 0.f) {
+                if (c.light)
+                    li *= kernel::trilinear(float_grid(c.light, c.light_dims), x * c.inv_stride,
+                                            y * c.inv_stride, z * c.inv_stride);
+                else
+                    li *= transmittance(c, g, accel, x, y, z, l, dist, shadow_n);
+            }
+            rgb = rgb * li;
+        }
+        // 4. Front-to-back compositing with early termination.
+        const float w = 1.f - acc.a;
+        acc.r += w * rgb.x * a;
+        acc.g += w * rgb.y * a;
+        acc.b += w * rgb.z * a;
+        acc.a += w * a;
+        return !(acc.a >= c.ert);
+    });
+    return n;
+}
+
+// MIP / MinIP: track the extreme LUT entry (src/accel/entry_window.h); `lo`/`hi` is the window
+// of entries that can still change it, read by an EntryWindowView cursor.
+template <class T, class Index, class Cursor>
+inline uint32_t extreme_ray(const Context& c, const kernel::Grid<T, Index>& g, Cursor& cursor,
+                            const kernel::IndexRay& r, float t_base, int k_end, bool maximum,
+                            int& lo, int& hi, kernel::Accum& acc) {
+    const int last = c.map.last();
+    int cur = maximum ? -1 : INT_MAX, cur_side = 0;
+    lo = 0;
+    hi = last;
+    uint32_t n = 0;
+    for_each_sample(cursor, t_base, c.dt, k_end, [&](int k) {
+        const float t = t_base + (float(k) + 0.5f) * c.dt;
+        const float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
+        if (!c.kept(x, y, z)) return true;
+        const int e = c.map(kernel::trilinear(g, x, y, z));
+        ++n;
+        if (maximum ? e > cur : e < cur) {
+            cur = e;
+            cur_side = c.side(x, y, z);
+            if (maximum) lo = cur + 1; else hi = cur - 1;
+        }
+        return maximum ? cur < last : cur > 0;  // nothing can beat the end of the table
+    });
+    if (cur >= 0 && cur <= last) {
+        const Rgba& raw = c.raw[cur_side][cur];
+        const float a = std::clamp(raw.a, 0.f, 1.f);
+        acc = {raw.r * a, raw.g * a, raw.b * a, a};
+    }
+    return n;
+}
+
+// Average: the TF at the mean value of the samples with non-zero TF opacity (on their side).
+template <class T, class Index, class Cursor>
+inline uint32_t average_ray(const Context& c, const kernel::Grid<T, Index>& g, Cursor& cursor,
+                            const kernel::IndexRay& r, float t_base, int k_end, kernel::Accum& acc) {
+    float sum = 0.f;
+    uint32_t count = 0, n = 0;
+    for_each_sample(cursor, t_base, c.dt, k_end, [&](int k) {
+        const float t = t_base + (float(k) + 0.5f) * c.dt;
+        const float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
+        if (!c.kept(x, y, z)) return true;
+        const float v = kernel::trilinear(g, x, y, z);
+        ++n;
+        if (c.raw[c.side(x, y, z)][c.map(v)].a > 0.f) {
+            sum += v;
+            ++count;
+        }
+        return true;
+    });
+    if (count) {
+        const Rgba& raw = c.raw[0][c.map(sum / float(count))];
+        const float a = std::clamp(raw.a, 0.f, 1.f);
+        acc = {raw.r * a, raw.g * a, raw.b * a, a};
+    }
+    return n;
+}
+
+// One tile of the feature path: per pixel, the ray, its (jittered) lattice, the cursor of the
+// blend mode, and the pixel.
+template <class T, class Index, class S>
+void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>& g,
+                 const Camera& cam, const RenderOptions& opt, int x0, int y0, int x1, int y1,
+                 RenderResult& out, Counts& counts) {
+    const FeatureOptions& f = *c.f;
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
+    const float chunk = 16.f * c.dt;
+    for (int py = y0; py < y1; ++py) {
+        for (int px = x0; px < x1; ++px) {
+            const Ray wr = cam.generate(float(px), float(py));
+            const Vec3f o = wr.origin * c.inv_sp, dir = wr.dir * c.inv_sp;
+            const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+            const Vec3f view = -wr.dir;
+            kernel::Accum acc;
+            uint32_t n = 0;
+            float t_near, t_far;
+            if (kernel::intersect_box(r, hi, t_near, t_far)) {
+                ++counts.rays;
+                const float j = f.jitter ? jitter(uint32_t(px), uint32_t(py), f.jitter_seed) : 0.5f;
+                const float t_base = t_near + (j - 0.5f) * c.dt;
+                const int k_end = std::max(int(std::ceil((t_far - t_base) / c.dt - 0.5f)), 0);
+                const CursorRay cr{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}};
+                if (f.blend == BlendMode::Mip || f.blend == BlendMode::MinIp) {
+                    const bool maximum = f.blend == BlendMode::Mip;
+                    int lo = 0, hi_e = c.map.last();
+                    bool done = false;
+                    if constexpr (HasEntryWindow<S>) {
+                        if (same_map(accel.value_map(), c.map)) {
+                            const EntryWindowView<S> view_s{&accel, &lo, &hi_e};
+                            RegionCursor<EntryWindowView<S>> cursor(view_s, cr, t_near, t_far, c.dt, chunk);
+                            n = extreme_ray(c, g, cursor, r, t_base, k_end, maximum, lo, hi_e, acc);
+                            done = true;
+                        }
+                    }
+                    if (!done) {
+                        static const NoAccel kNone;
+                        NoAccel::Cursor cursor(kNone, cr, t_near, t_far);
+                        n = extreme_ray(c, g, cursor, r, t_base, k_end, maximum, lo, hi_e, acc);
+                    }
+                } else {
+                    typename S::Cursor cursor(accel, cr, t_near, t_far, c.dt,
+                                              f.blend == BlendMode::Composite && c.ert < 1.f ? chunk : 0.f);
+                    if (f.blend == BlendMode::Average)
+                        n = average_ray(c, g, cursor, r, t_base, k_end, acc);
+                    else
+                        n = composite_ray(c, g, accel, cursor, r, view, t_base, k_end, acc, counts.shadow);
+                }
+            }
+            counts.samples += n;
+            const float w = 1.f - acc.a;
+            uint8_t* p = out.image.pixel(px, py);
+            const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
+                                  acc.b + w * opt.background.z};
+            for (int ch = 0; ch < 3; ++ch)
+                p[ch] = uint8_t(std::lround(std::clamp(rgb[ch], 0.f, 1.f) * 255.f));
+            p[3] = 255;
+            if (opt.keep_float) {
+                float* fl = &out.rgba_float[(size_t(py) * size_t(out.image.width) + px) * 4];
+                fl[0] = acc.r, fl[1] = acc.g, fl[2] = acc.b, fl[3] = acc.a;
+            }
+            if (opt.count_samples) out.sample_counts[size_t(py) * size_t(out.image.width) + px] = n;
+        }
+    }
+}
+
+}  // namespace lacuna::feature

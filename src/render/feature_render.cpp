@@ -1,0 +1,230 @@
+// RayMarcher::render_features: validates the feature options, sets up the feature kernel's
+// context (LUTs per side, index-space clip planes, lights), fills the cache of precomputed
+// gradient and light volumes, and runs src/render/feature_kernel.h over the tiles.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "accel/accel_impl.h"
+#include "core/parallel.h"
+#include "lacuna/error.h"
+#include "lacuna/renderer.h"
+#include "render/feature_kernel.h"
+#include "render/marcher_cache.h"
+
+namespace lacuna {
+
+namespace {
+
+bool finite3(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+}  // namespace
+
+void validate_features(const FeatureOptions& f) {
+    auto fail = [](const char* opt, const char* what, const std::string& expected) {
+        throw Error(opt, what, expected);
+    };
+    const PhongParams& p = f.phong;
+    if (!(p.ambient >= 0 && p.diffuse >= 0 && p.specular >= 0 && p.power >= 0) ||
+        !std::isfinite(p.ambient + p.diffuse + p.specular + p.power))
+        fail("--phong", "parameters", "expected finite ambient, diffuse, specular, power >= 0");
+    if (!(f.pbr.roughness > 0 && f.pbr.roughness <= 1) || !(f.pbr.metallic >= 0 && f.pbr.metallic <= 1) ||
+        !(f.pbr.ambient >= 0 && std::isfinite(f.pbr.ambient)))
+        fail("--pbr", "parameters", "expected roughness in (0,1], metallic in [0,1], ambient >= 0");
+    if (f.gradient_opacity.enabled &&
+        !(f.gradient_opacity.lo >= 0 && f.gradient_opacity.lo <= f.gradient_opacity.hi &&
+          std::isfinite(f.gradient_opacity.hi)))
+        fail("--gradient-opacity", "ramp", "expected 0 <= LO <= HI");
+    const Light& l = f.light;
+    if (!(l.intensity >= 0 && std::isfinite(l.intensity)))
+        fail("--light", "intensity", "expected a finite intensity >= 0");
+    if (l.kind == LightKind::Directional && !(finite3(l.direction) && length(l.direction) > 0))
+        fail("--light", "direction", "expected a finite non-zero direction");
+    if (l.kind == LightKind::Spot &&
+        (!finite3(l.position) || !finite3(l.target) || !(length(l.target - l.position) > 0) ||
+         !(l.cone_deg > 0 && l.cone_deg < 90)))
+        fail("--light", "spot", "expected position != target and a cone half-angle in (0, 90) degrees");
+    if (!(f.shadows.step > 0 && f.shadows.step <= 64))
+        fail("--shadow-step", "step", "expected 0 < step <= 64");
+    if (f.shadows.light_volume_stride < 1 || f.shadows.light_volume_stride > 64)
+        fail("--light-volume", "stride", "expected 1..64");
+    for (const ClipPlane& c : f.clip_planes)
+        if (!finite3(c.normal) || !(length(c.normal) > 0) || !std::isfinite(c.d))
+            fail("--clip", "plane", "expected a finite non-zero normal and a finite offset");
+    if (f.crop && !(finite3(f.crop_box.lo) && finite3(f.crop_box.hi) && f.crop_box.lo.x <= f.crop_box.hi.x &&
+                    f.crop_box.lo.y <= f.crop_box.hi.y && f.crop_box.lo.z <= f.crop_box.hi.z))
+        fail("--crop", "box", "expected x0 <= x1, y0 <= y1, z0 <= z1");
+}
+
+namespace {
+
+// Per-voxel central differences (one-sided at the faces), in voxel values per mm.
+template <class T>
+void gradient_volume(const Volume& v, const T* data, std::vector<float> out[3], int threads) {
+    const Vec3i d = v.dims();
+    for (int a = 0; a < 3; ++a) out[a].assign(v.voxel_count(), 0.f);
+    const float inv[3] = {float(1.0 / v.spacing.x), float(1.0 / v.spacing.y), float(1.0 / v.spacing.z)};
+    parallel_for(size_t(d.z), threads, [&](size_t z0, size_t z1) {
+        for (int k = int(z0); k < int(z1); ++k)
+            for (int j = 0; j < d.y; ++j)
+                for (int i = 0; i < d.x; ++i) {
+                    auto at = [&](int x, int y, int z) {
+                        x = std::clamp(x, 0, d.x - 1), y = std::clamp(y, 0, d.y - 1), z = std::clamp(z, 0, d.z - 1);
+                        return float(data[v.index(x, y, z)]);
+                    };
+                    const size_t idx = v.index(i, j, k);
+                    out[0][idx] = (at(i + 1, j, k) - at(i - 1, j, k)) * 0.5f * inv[0];
+                    out[1][idx] = (at(i, j + 1, k) - at(i, j - 1, k)) * 0.5f * inv[1];
+                    out[2][idx] = (at(i, j, k + 1) - at(i, j, k - 1)) * 0.5f * inv[2];
+                }
+    });
+}
+
+// Everything the light volume depends on, exactly (hex floats).
+std::string light_key(const FeatureOptions& f, Vec3f l_fixed, uint64_t tf_version, float ert) {
+    std::string k;
+    char buf[128];
+    auto add = [&](float x) {
+        std::snprintf(buf, sizeof buf, "%a,", double(x));
+        k += buf;
+    };
+    k += to_string(f.light.kind) + ":";
+    for (Vec3f v : {l_fixed, f.light.position, f.light.target}) add(v.x), add(v.y), add(v.z);
+    add(f.light.cone_deg), add(f.shadows.step), add(ert), add(float(f.shadows.light_volume_stride));
+    for (const ClipPlane& c : f.clip_planes) add(c.normal.x), add(c.normal.y), add(c.normal.z), add(c.d);
+    if (f.crop)
+        for (Vec3f v : {f.crop_box.lo, f.crop_box.hi}) add(v.x), add(v.y), add(v.z);
+    return k + "tf" + std::to_string(tf_version);
+}
+
+}  // namespace
+
+RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions& opt) const {
+    const FeatureOptions& f = opt.features;
+    validate_features(f);
+    const bool two_tfs = !m_back_lut.entries.empty();
+    if (two_tfs && f.clip_planes.empty())
+        throw Error("--tf-back", "clip plane", "a back TF needs a clip plane (--clip) to split at");
+    if (two_tfs) union_lut(m_lut, m_back_lut);  // throws if the LUTs are incompatible
+
+    RenderResult out;
+    out.image = Image(cam.width(), cam.height());
+    if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);
+    if (opt.keep_float) out.rgba_float.assign(size_t(cam.width()) * cam.height() * 4, 0.f);
+
+    // 1. LUTs per side.
+    const TransferLut& back = two_tfs ? m_back_lut : m_lut;
+    const std::vector<Rgba> corr0 = step_corrected_lut(m_lut, opt.step),
+                            corr1 = step_corrected_lut(back, opt.step),
+                            sh0 = step_corrected_lut(m_lut, f.shadows.step),
+                            sh1 = step_corrected_lut(back, f.shadows.step);
+    feature::Context c;
+    c.f = &f;
+    c.raw[0] = m_lut.entries.data(), c.raw[1] = back.entries.data();
+    c.corr[0] = corr0.data(), c.corr[1] = corr1.data();
+    c.shadow_corr[0] = sh0.data(), c.shadow_corr[1] = sh1.data();
+    c.map = m_lut.map();
+    c.two_tfs = two_tfs;
+    c.threads = opt.threads;
+
+    // 2. Geometry in index space.
+    const Vec3d& s = m_volume.spacing;
+    c.sp = {float(s.x), float(s.y), float(s.z)};
+    c.inv_sp = {float(1.0 / s.x), float(1.0 / s.y), float(1.0 / s.z)};
+    const float min_sp = float(std::min({s.x, s.y, s.z}));
+    c.step = opt.step;
+    c.dt = opt.step * min_sp;
+    c.dts = f.shadows.step * min_sp;
+    c.ert = opt.ert;
+    std::vector<feature::HalfSpace> clips;
+    for (size_t i = 0; i < f.clip_planes.size(); ++i) {
+        const feature::HalfSpace h = feature::to_index(f.clip_planes[i], c.sp);
+        if (two_tfs && i == 0)
+            c.split = h;
+        else
+            clips.push_back(h);
+    }
+    c.clips = clips.data();
+    c.n_clips = int(clips.size());
+    if (f.crop)
+        for (int a = 0; a < 3; ++a) {
+            c.crop_lo[a] = f.crop_box.lo[a] * c.inv_sp[a];
+            c.crop_hi[a] = f.crop_box.hi[a] * c.inv_sp[a];
+        }
+    const bool composite = f.blend == BlendMode::Composite;
+    c.need_gradient = composite && (f.shading != ShadingModel::None || f.gradient_opacity.enabled);
+    c.light_dir = f.light.kind == LightKind::Directional ? normalize(f.light.direction) : Vec3f{0, 0, 1};
+    if (f.light.kind == LightKind::Spot) c.spot_axis = normalize(f.light.target - f.light.position);
+    const bool shadows = composite && f.shadows.enabled;
+
+    std::lock_guard<std::mutex> lock(m_cache->mutex);
+    // 3. The precomputed gradient volume (once per marcher: it depends on the volume only).
+    if (c.need_gradient && f.gradient == GradientSource::Precomputed) {
+        if (m_cache->grad[0].empty()) {
+            const auto t0 = std::chrono::steady_clock::now();
+            visit_voxels(m_volume, [&](const auto* data) {
+                gradient_volume(m_volume, data, m_cache->grad, opt.threads);
+            });
+            out.stats.gradient_volume_seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        }
+        for (int a = 0; a < 3; ++a) c.grad[a] = m_cache->grad[a].data();
+        out.stats.gradient_volume_bytes = 3 * m_cache->grad[0].size() * sizeof(float);
+    }
+
+    std::atomic<uint64_t> samples{0}, rays{0}, shadow{0};
+    const Vec3i d = m_volume.dims();
+    const auto t0 = std::chrono::steady_clock::now();
+    visit_voxels(m_volume, [&](const auto* data) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
+        // The feature path always indexes with int64 (it is not the hot path for huge grids).
+        const kernel::Grid<T, int64_t> g{data, ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
+                                         float(d.x - 1), float(d.y - 1), float(d.z - 1),
+                                         d.x - 2, d.y - 2, d.z - 2};
+        static const NoAccel kNone;
+        visit_accel(m_accel ? *m_accel : kNone, [&](const auto& acc) {
+            // 4. The light volume, when the light, TF or clipping changed since it was made.
+            if (shadows && f.shadows.light_volume) {
+                const Vec3f l_fixed = f.light.kind == LightKind::Head ? -cam.forward() : c.light_dir;
+                const std::string key = light_key(f, l_fixed, m_tf_version, opt.ert);
+                const int stride = f.shadows.light_volume_stride;
+                int* m = m_cache->light_dims;
+                if (key != m_cache->light_key) {
+                    const auto l0 = std::chrono::steady_clock::now();
+                    m[0] = std::max(2, (d.x - 2) / stride + 2);
+                    m[1] = std::max(2, (d.y - 2) / stride + 2);
+                    m[2] = std::max(2, (d.z - 2) / stride + 2);
+                    m_cache->light.assign(size_t(m[0]) * m[1] * m[2], 1.f);
+                    for (int a = 0; a < 3; ++a) c.light_dims[a] = m[a];
+                    feature::build_light_volume(c, g, acc, l_fixed, float(stride),
+                                                m_cache->light.data(), shadow);
+                    m_cache->light_key = key;
+                    out.stats.light_volume_seconds =
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - l0).count();
+                }
+                for (int a = 0; a < 3; ++a) c.light_dims[a] = m[a];
+                c.light = m_cache->light.data();
+                c.inv_stride = 1.f / float(stride);
+                out.stats.light_volume_bytes = m_cache->light.size() * sizeof(float);
+            }
+            // 5. The frame.
+            parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                               [&](int x0, int y0, int x1, int y1) {
+                                   feature::Counts n;
+                                   feature::render_tile(c, acc, g, cam, opt, x0, y0, x1, y1, out, n);
+                                   samples += n.samples;
+                                   rays += n.rays;
+                                   shadow += n.shadow;
+                               });
+        });
+    });
+    out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out.stats.samples = samples;
+    out.stats.rays = rays;
+    out.stats.shadow_samples = shadow;
+    out.stats.pixels = uint64_t(cam.width()) * cam.height();
+    return out;
+}
+
+}  // namespace lacuna

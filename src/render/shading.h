@@ -1,0 +1,114 @@
+// Surface shading of volume samples (docs/shading.md): Blinn-Phong, and the bitfield paper's
+// physically based model (Section 4.4, after Unity's Standard Shader): Disney diffuse [Bur12],
+// GGX normal distribution [WMLT07], Smith joint GGX visibility [Hei14], Schlick Fresnel [Sch94].
+//
+// Conventions: all vectors in world space, unit length. N is the surface normal estimated from
+// the gradient (N = -grad/|grad|, pointing from high to low values), flipped toward the viewer
+// (two-sided lighting: a shell is lit from inside and outside alike). L points to the light, V
+// to the eye. Colours are linear RGB; the result is not clamped (the image writer clamps).
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+#include "lacuna/math.h"
+#include "lacuna/renderer.h"
+
+namespace lacuna::shading {
+
+inline constexpr float kPi = 3.14159265358979f;
+
+// The normal from a world-space gradient, facing the viewer; false when the gradient is zero
+// (no surface: the sample keeps its TF colour).
+inline bool normal_from_gradient(Vec3f g, Vec3f view, Vec3f& n) {
+    const float len2 = dot(g, g);
+    if (!(len2 > 0.f)) return false;
+    n = g * (-1.f / std::sqrt(len2));
+    if (dot(n, view) < 0.f) n = -n;
+    return true;
+}
+
+// Blinn-Phong: rgb*(ambient + diffuse*Li*max(N.L,0)) + specular*Li*max(N.H,0)^power.
+// `li` is the light's intensity at the sample (spot falloff and shadowing applied).
+inline Vec3f phong(const PhongParams& p, Vec3f rgb, Vec3f n, Vec3f l, Vec3f v, float li) {
+    const float ndl = std::max(dot(n, l), 0.f);
+    Vec3f h = l + v;
+    const float hl = length(h);
+    float spec = 0.f;
+    if (ndl > 0.f && hl > 0.f) spec = std::pow(std::max(dot(n, h / hl), 0.f), p.power);
+    const float k = p.ambient + p.diffuse * li * ndl;
+    const float s = p.specular * li * spec;
+    return {rgb.x * k + s, rgb.y * k + s, rgb.z * k + s};
+}
+
+// Disney diffuse (Burley 2012), without the 1/pi (Unity's convention: the light's intensity is
+// its radiance times pi).
+inline float disney_diffuse(float ndv, float ndl, float ldh, float roughness) {
+    const float fd90 = 0.5f + 2.f * ldh * ldh * roughness;
+    const float lv = 1.f - ndl, vv = 1.f - ndv;
+    const float fl = 1.f + (fd90 - 1.f) * lv * lv * lv * lv * lv;
+    const float fv = 1.f + (fd90 - 1.f) * vv * vv * vv * vv * vv;
+    return fl * fv;
+}
+
+// GGX / Trowbridge-Reitz normal distribution, alpha = roughness^2.
+inline float ggx_d(float ndh, float alpha) {
+    const float a2 = alpha * alpha;
+    const float d = ndh * ndh * (a2 - 1.f) + 1.f;
+    return a2 / (kPi * d * d + 1e-7f);
+}
+
+// Smith joint GGX visibility term V = G / (4 N.L N.V) (Heitz 2014, Eq. 99).
+inline float smith_joint_ggx_v(float ndl, float ndv, float alpha) {
+    const float a2 = alpha * alpha;
+    const float gl = ndv * std::sqrt(ndl * ndl * (1.f - a2) + a2);
+    const float gv = ndl * std::sqrt(ndv * ndv * (1.f - a2) + a2);
+    return 0.5f / (gl + gv + 1e-5f);
+}
+
+// Schlick's Fresnel approximation for reflectance f0 at normal incidence.
+inline float schlick(float f0, float ldh) {
+    const float m = 1.f - ldh;
+    return f0 + (1.f - f0) * m * m * m * m * m;
+}
+
+// The physically based model: albedo*(1-metallic) * (ambient + Li * Disney * N.L)
+//   + Li * pi * D * V * F * N.L,  F0 = lerp(0.04, albedo, metallic).
+inline Vec3f pbr(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, float li) {
+    const float rough = std::clamp(p.roughness, 0.02f, 1.f);
+    const float alpha = rough * rough;
+    const float ndl = std::max(dot(n, l), 0.f);
+    const float ndv = std::max(dot(n, v), 1e-4f);
+    Vec3f h = l + v;
+    const float hl = length(h);
+    h = hl > 0.f ? h / hl : n;
+    const float ndh = std::max(dot(n, h), 0.f), ldh = std::max(dot(l, h), 0.f);
+    const float diffuse = li * disney_diffuse(ndv, ndl, ldh, rough) * ndl;
+    const float spec_common = li * kPi * ggx_d(ndh, alpha) * smith_joint_ggx_v(ndl, ndv, alpha) * ndl;
+    const float m = std::clamp(p.metallic, 0.f, 1.f);
+    const float c[3] = {albedo.x, albedo.y, albedo.z};
+    float out[3];
+    for (int i = 0; i < 3; ++i) {
+        const float f0 = 0.04f * (1.f - m) + c[i] * m;
+        const float kd = c[i] * (1.f - m);
+        out[i] = kd * (p.ambient + diffuse) + spec_common * schlick(f0, ldh);
+    }
+    return {out[0], out[1], out[2]};
+}
+
+// Spot falloff: 1 inside 0.8*cone, 0 outside the cone, smoothstep between.
+inline float spot_factor(float cos_angle, float cone_deg) {
+    const float c_out = std::cos(cone_deg * kPi / 180.f), c_in = std::cos(0.8f * cone_deg * kPi / 180.f);
+    if (cos_angle <= c_out) return 0.f;
+    if (cos_angle >= c_in) return 1.f;
+    const float x = (cos_angle - c_out) / (c_in - c_out);
+    return x * x * (3.f - 2.f * x);
+}
+
+// VTK-style gradient opacity ramp over |grad|.
+inline float gradient_opacity(const GradientOpacity& g, float mag) {
+    if (mag >= g.hi) return 1.f;
+    if (mag <= g.lo) return g.lo == g.hi ? (mag >= g.hi ? 1.f : 0.f) : 0.f;
+    return (mag - g.lo) / (g.hi - g.lo);
+}
+
+}  // namespace lacuna::shading
