@@ -3,7 +3,8 @@
 // waits for a frame, drags a TF opacity point, and checks that the image changes, that the
 // overlay reports the TF-change time, that a second tab is served, that the page logged no
 // console errors, and that Ctrl-C (SIGINT) stops the server cleanly. Saves a screenshot of the
-// viewer to docs/images/viewer.png (README).
+// viewer to --screenshot (default docs/images/viewer.png, the README picture; ctest passes a path in
+// the build folder so a test run leaves the checkout untouched).
 //
 // Usage: node tests/e2e/viewer.e2e.mjs [--lacuna build/lacuna] [--chromium /usr/bin/chromium]
 //                                       [--screenshot docs/images/viewer.png]
