@@ -19,6 +19,8 @@
     renderer: 'march',
     accel: 'bitfield',
     ert: true,
+    shading: false,
+    clip: false,
     step: 0.5,
     // TF in the normalized domain: x in [0,1] across the volume's visualization range (or
     // tf.range when set). color: [x, r, g, b]; opacity: [x, a].
@@ -128,7 +130,7 @@
     ws.send(JSON.stringify({
       type: 'render', id, width: w, height: h, preview: dirtyPreview,
       camera: state.camera, renderer: state.renderer, accel: state.accel,
-      ert: state.ert, step: state.step, tf: state.tf,
+      ert: state.ert, step: state.step, tf: state.tf, shading: state.shading, clip: state.clip,
     }));
     inFlight = id;
     dirty = false;
@@ -234,6 +236,8 @@
   $('renderer').addEventListener('change', (e) => { state.renderer = e.target.value; request(false); });
   $('accel').addEventListener('change', (e) => { state.accel = e.target.value; request(false); });
   $('ert').addEventListener('change', (e) => { state.ert = e.target.checked; request(false); });
+  $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; request(false); });
+  $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; request(false); });
   $('step').addEventListener('input', (e) => {
     state.step = Number(e.target.value);
     $('step-value').textContent = e.target.value;

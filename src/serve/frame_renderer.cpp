@@ -107,6 +107,12 @@ RenderOptions FrameRenderer::render_options(const ViewRequest& req) const {
     ro.step = req.step;
     ro.ert = req.ert ? 0.99f : 2.f;  // as `lacuna render --ert 1`: opacity never reaches 2
     ro.threads = m_threads;
+    if (req.shading) ro.features.shading = ShadingModel::Phong;  // default light: the headlight
+    if (req.clip) {
+        // Keep dot((-1,0,0), p) >= -cx, i.e. x <= cx: the half of the volume with smaller x.
+        const Box3f b = m_marcher->bounds();
+        ro.features.clip_planes.push_back(ClipPlane{{-1.f, 0.f, 0.f}, -b.center().x});
+    }
     return ro;
 }
 

@@ -129,7 +129,7 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     if (type != "render") reject("type", "unknown message type '" + type + "'; expected render");
     only_keys(j,
               {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
-               "step", "tf"},
+               "step", "tf", "shading", "clip"},
               "");
     ViewRequest r;
     r.id = id_of(j);
@@ -162,6 +162,10 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
         reject("accel", e.what());
     }
     r.ert = boolean(j, "ert", "");
+    // Optional toggles (absent = off): Phong shading with a headlight, and a clip plane through
+    // the volume's centre that removes the half with x > centre (a cut-away of a head).
+    if (j.contains("shading")) r.shading = boolean(j, "shading", "");
+    if (j.contains("clip")) r.clip = boolean(j, "clip", "");
     r.step = float(number(j, "step", 0.1, 8, ""));
 
     const json& tf = need(j, "tf", "");

@@ -6,6 +6,7 @@
 //   {"type":"render", "id":N, "width":W, "height":H, "preview":bool,
 //    "camera":{"azimuth":deg, "elevation":deg, "zoom":f, "pan":[x,y]},
 //    "renderer":"march", "accel":"bitfield", "ert":bool, "step":f,
+//    ["shading":bool, "clip":bool,]  (optional toggles, off when absent)
 //    "tf":{...the transfer-function JSON of docs/transfer-functions.md...}}
 //   Every request carries the whole view state, so the server can drop all but the latest.
 //   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
@@ -57,6 +58,8 @@ struct ViewRequest {
     AccelKind accel = AccelKind::None;
     bool ert = true;    // early ray termination at 0.99 (false: off)
     float step = 0.5f;  // sample distance in smallest voxel spacings, [0.1, 8]
+    bool shading = false;  // optional "shading": Phong with a headlight (docs/shading.md)
+    bool clip = false;     // optional "clip": keep x <= the volume's centre (a cut-away)
     TransferFunction tf;
 };
 

@@ -97,6 +97,15 @@ try {
   check(/ms update/.test(tfText) && Number.isFinite(tfMs) && tfMs >= 0,
         `overlay reports the TF change: "${tfText}"`);
 
+  // The shading and clip-plane toggles each change the picture.
+  for (const id of ['shading', 'clip']) {
+    const shot = await img.screenshot();
+    const n = await page.evaluate(() => window.lacunaViewer.frames());
+    await page.check('#' + id);
+    await waitFullFrame(page, n);
+    check(Buffer.compare(shot, await img.screenshot()) !== 0, `the ${id} toggle changes the image`);
+  }
+
   // A second tab at the same time.
   const page2 = await context.newPage();
   page2.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });

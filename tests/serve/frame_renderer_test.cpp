@@ -77,6 +77,28 @@ TEST(FrameRenderer, SameBytesAsTheCliRenderer) {
     }
 }
 
+TEST(FrameRenderer, ShadingAndClipTogglesAreTheCliFlags) {
+    // The page's toggles: Phong with the headlight, and the plane keeping x <= the centre (16 mm
+    // for the 33-voxel-wide shells at 1 mm).
+    const fs::path out = temp_dir() / "cli_shaded.png";
+    const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + shells_file().string() +
+                            " --tf mr-default --accel minmax --width 40 --height 36"
+                            " --azimuth 40 --elevation 20 --zoom 1.3 --step 0.5 --ert 1"
+                            " --shading phong --clip -1,0,0,-16 --out " + out.string() +
+                            " >/dev/null";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+    const Image cli = read_png(out.string());
+    FrameRenderer fr(read_volume(shells_file().string()));
+    ViewRequest req = request(AccelKind::MinMax, "mr-default");
+    req.shading = true;
+    req.clip = true;
+    const Frame f = fr.render(req, 40, 36);
+    EXPECT_EQ(f.image.rgba, cli.rgba);
+    req.shading = req.clip = false;
+    EXPECT_NE(fr.render(req, 40, 36).image.rgba, cli.rgba) << "the toggles change the picture";
+}
+
 TEST(FrameRenderer, EveryStructureMatchesNoneThroughTfChangesAndSwitches) {
     SyntheticOptions so;
     so.dims = {25, 21, 19};

@@ -62,6 +62,22 @@ TEST(Protocol, ParsesAWellFormedRequest) {
     EXPECT_EQ(r.tf.opacity[1].x, 0.5);
     EXPECT_EQ(r.tf.opacity[1].a, 0.25f);
     EXPECT_EQ(r.tf.color[1].b, 1.f);
+    EXPECT_FALSE(r.shading) << "optional toggles are off when absent";
+    EXPECT_FALSE(r.clip);
+}
+
+TEST(Protocol, ParsesTheOptionalShadingAndClipToggles) {
+    json j = good_request();
+    j["shading"] = true;
+    j["clip"] = true;
+    const ViewRequest r = parse_request(j.dump());
+    EXPECT_TRUE(r.shading);
+    EXPECT_TRUE(r.clip);
+    j["shading"] = "phong";
+    expect_rejected(j, "shading");
+    j = good_request();
+    j["clip"] = 1;
+    expect_rejected(j, "clip");
 }
 
 TEST(Protocol, EveryPresetRoundTripsThroughARequest) {
