@@ -233,11 +233,29 @@
     }
     sel.value = names.includes(value) ? value : names[0];
   }
-  $('renderer').addEventListener('change', (e) => { state.renderer = e.target.value; request(false); });
-  $('accel').addEventListener('change', (e) => { state.accel = e.target.value; request(false); });
+  $('renderer').addEventListener('change', (e) => {
+    state.renderer = e.target.value;
+    if (state.renderer === 'slice') {
+      // The slicer renders boxes: the whole volume (none) or the kd-tree's; no shading/clipping.
+      if (state.accel !== 'none' && state.accel !== 'kdtree') state.accel = 'kdtree';
+      $('accel').value = state.accel;
+      state.shading = state.clip = false;
+      $('shading').checked = $('clip').checked = false;
+    }
+    request(false);
+  });
+  // Choices the slicer cannot render switch back to the ray marcher.
+  const marchIfSlicer = () => {
+    if (state.renderer === 'slice') { state.renderer = 'march'; $('renderer').value = 'march'; }
+  };
+  $('accel').addEventListener('change', (e) => {
+    state.accel = e.target.value;
+    if (state.accel !== 'none' && state.accel !== 'kdtree') marchIfSlicer();
+    request(false);
+  });
   $('ert').addEventListener('change', (e) => { state.ert = e.target.checked; request(false); });
-  $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; request(false); });
-  $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; request(false); });
+  $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; if (state.shading) marchIfSlicer(); request(false); });
+  $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; if (state.clip) marchIfSlicer(); request(false); });
   $('step').addEventListener('input', (e) => {
     state.step = Number(e.target.value);
     $('step-value').textContent = e.target.value;

@@ -7,6 +7,7 @@
 
 #include "core/parallel.h"
 #include "render/ray_march_kernel.h"
+#include "slice/box_sources.h"
 
 namespace lacuna::serve {
 
@@ -127,7 +128,52 @@ Accel& FrameRenderer::accel(AccelKind k, double& build_seconds) {
     return *b.accel;
 }
 
+Frame FrameRenderer::render_slice(const ViewRequest& req, int width, int height) {
+    Frame f;
+    const auto t0 = Clock::now();
+    if (!m_slicer) m_slicer = std::make_unique<SliceRenderer>(*m_volume);
+    if (!m_has_tf || !(req.tf == m_tf)) {
+        m_tf = req.tf;
+        m_has_tf = true;
+        ++m_tf_version;
+        m_lut = discretise(m_tf, m_volume->vis_range());
+        m_marcher->set_transfer_function(m_lut);
+        f.tf_changed = true;
+    }
+    m_slicer->set_transfer_function(m_lut);
+    BuiltSource& b = m_sources[req.accel];
+    if (!b.source) {
+        const auto tb = Clock::now();
+        b.source = make_box_source(req.accel == AccelKind::KdTree ? "kdtree" : "none", *m_volume,
+                                   m_accel_options);
+        f.accel_build_seconds = seconds_since(tb);
+    }
+    if (b.tf_version != m_tf_version) {
+        b.source->set_transfer_function(m_lut);
+        b.tf_version = m_tf_version;
+    }
+    if (f.tf_changed) f.tf_update_seconds = seconds_since(t0);
+    m_slicer->set_box_source(b.source.get());
+    const Camera cam = camera(req.camera, width, height);
+    SliceOptions so;
+    so.step = req.step;
+    so.ert = req.ert ? 0.99f : 2.f;
+    so.threads = m_threads;
+    SliceResult r = m_slicer->render(cam, so);
+    f.image = std::move(r.image);
+    f.stats.seconds = r.stats.seconds;
+    f.stats.samples = r.stats.samples;
+    f.stats.pixels = uint64_t(width) * uint64_t(height);
+    f.stats.rays = f.stats.pixels;  // the slicer has no rays: samples per pixel
+    f.lattice_samples = lattice_samples(*m_volume, cam, req.step, m_threads);
+    f.skipped = f.lattice_samples && f.stats.samples < f.lattice_samples
+                    ? 1.0 - double(f.stats.samples) / double(f.lattice_samples)
+                    : 0.0;
+    return f;
+}
+
 Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
+    if (req.renderer == RendererKind::Slice) return render_slice(req, width, height);
     Frame f;
     // 1. A new TF: discretise it and hand it to the marcher and the current structure (the
     //    "TF change -> ready to render" time of the bitfield paper, Section 4.5).

@@ -16,6 +16,8 @@
 #include "lacuna/renderer.h"
 #include "lacuna/volume.h"
 #include "serve/protocol.h"
+#include "slice/box_source.h"
+#include "slice/slice_renderer.h"
 
 namespace lacuna::serve {
 
@@ -64,6 +66,14 @@ class FrameRenderer {
         uint64_t tf_version = 0;  // the TF version it holds
     };
     std::map<AccelKind, Built> m_accels;
+    // The slicer and its box sources (built lazily, like the structures).
+    std::unique_ptr<SliceRenderer> m_slicer;
+    struct BuiltSource {
+        std::unique_ptr<BoxSource> source;
+        uint64_t tf_version = 0;
+    };
+    std::map<AccelKind, BuiltSource> m_sources;
+    Frame render_slice(const ViewRequest& req, int width, int height);
     bool m_has_tf = false;
     TransferFunction m_tf;
     TransferLut m_lut;

@@ -115,12 +115,14 @@ std::string to_string(RendererKind k) {
     switch (k) {
         case RendererKind::March:
             return "march";
+        case RendererKind::Slice:
+            return "slice";
     }
     return "?";
 }
 
 std::vector<std::string> renderer_names() {
-    return {"march"};
+    return {"march", "slice"};
 }
 
 ViewRequest parse_request(std::string_view text, const Limits& limits) {
@@ -154,8 +156,8 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     const std::string renderer = text_of(j, "renderer", "");
     bool found = false;
     for (const auto& n : renderer_names()) found = found || n == renderer;
-    if (!found) reject("renderer", "unknown '" + renderer + "'; expected march");
-    r.renderer = RendererKind::March;
+    if (!found) reject("renderer", "unknown '" + renderer + "'; expected march or slice");
+    r.renderer = renderer == "slice" ? RendererKind::Slice : RendererKind::March;
     try {
         r.accel = parse_accel(text_of(j, "accel", ""));
     } catch (const Error& e) {
@@ -166,6 +168,12 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     // the volume's centre that removes the half with x > centre (a cut-away of a head).
     if (j.contains("shading")) r.shading = boolean(j, "shading", "");
     if (j.contains("clip")) r.clip = boolean(j, "clip", "");
+    if (r.renderer == RendererKind::Slice) {
+        if (r.accel != AccelKind::None && r.accel != AccelKind::KdTree)
+            reject("accel", "the slice renderer takes none (Basic) or kdtree, not '" +
+                                to_string(r.accel) + "'");
+        if (r.shading || r.clip) reject("renderer", "the slice renderer has no shading or clipping");
+    }
     r.step = float(number(j, "step", 0.1, 8, ""));
 
     const json& tf = need(j, "tf", "");

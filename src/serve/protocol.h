@@ -31,8 +31,9 @@ namespace lacuna::serve {
 
 inline constexpr int kProtocolVersion = 1;
 
-// Renderers the viewer can drive. The slicer joins this list when it lands.
-enum class RendererKind { March };
+// Renderers the viewer can drive: the ray marcher and the object-order slicer (docs/slicer.md;
+// it takes the structures `none` (Basic) and `kdtree` (the kd-tree's boxes)).
+enum class RendererKind { March, Slice };
 std::string to_string(RendererKind k);
 std::vector<std::string> renderer_names();
 

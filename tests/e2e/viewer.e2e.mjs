@@ -106,6 +106,19 @@ try {
     check(Buffer.compare(shot, await img.screenshot()) !== 0, `the ${id} toggle changes the image`);
   }
 
+  // The slice renderer (the page switches the structure to kdtree and the toggles off).
+  {
+    const n = await page.evaluate(() => window.lacunaViewer.frames());
+    await page.selectOption('#renderer', 'slice');
+    await waitFullFrame(page, n);
+    const st = await page.evaluate(() => window.lacunaViewer.state);
+    check(st.renderer === 'slice' && st.accel === 'kdtree' && !st.shading,
+          `the slicer renders (structure ${st.accel})`);
+    const m = await page.evaluate(() => window.lacunaViewer.frames());
+    await page.selectOption('#renderer', 'march');
+    await waitFullFrame(page, m);
+  }
+
   // A second tab at the same time.
   const page2 = await context.newPage();
   page2.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });

@@ -77,6 +77,29 @@ TEST(FrameRenderer, SameBytesAsTheCliRenderer) {
     }
 }
 
+TEST(FrameRenderer, SliceRendererFramesAreTheCliSlicer) {
+    for (const char* accel : {"none", "kdtree"}) {
+        const fs::path out = temp_dir() / (std::string("cli_slice_") + accel + ".png");
+        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " +
+                                shells_file().string() +
+                                " --tf mr-default --renderer slice --accel " + accel +
+                                " --width 40 --height 36 --azimuth 40 --elevation 20 --zoom 1.3"
+                                " --step 0.5 --ert 1 --out " + out.string() + " >/dev/null";
+        const int status = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+        const Image cli = read_png(out.string());
+        FrameRenderer fr(read_volume(shells_file().string()));
+        ViewRequest req = request(parse_accel(accel), "mr-default");
+        req.renderer = RendererKind::Slice;
+        const Frame f = fr.render(req, 40, 36);
+        EXPECT_EQ(f.image.rgba, cli.rgba) << accel;
+        EXPECT_GT(f.stats.samples, 0u);
+        // and back to the marcher on the same renderer
+        req.renderer = RendererKind::March;
+        EXPECT_GT(fr.render(req, 40, 36).stats.samples, 0u);
+    }
+}
+
 TEST(FrameRenderer, ShadingAndClipTogglesAreTheCliFlags) {
     // The page's toggles: Phong with the headlight, and the plane keeping x <= the centre (16 mm
     // for the 33-voxel-wide shells at 1 mm).

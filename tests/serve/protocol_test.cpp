@@ -66,6 +66,18 @@ TEST(Protocol, ParsesAWellFormedRequest) {
     EXPECT_FALSE(r.clip);
 }
 
+TEST(Protocol, TheSliceRendererTakesNoneOrKdtreeAndNoFeatures) {
+    json j = good_request();
+    j["renderer"] = "slice";
+    j["accel"] = "kdtree";
+    EXPECT_EQ(parse_request(j.dump()).renderer, RendererKind::Slice);
+    j["accel"] = "bitfield";
+    expect_rejected(j, "accel");
+    j["accel"] = "none";
+    j["shading"] = true;
+    expect_rejected(j, "renderer");
+}
+
 TEST(Protocol, ParsesTheOptionalShadingAndClipToggles) {
     json j = good_request();
     j["shading"] = true;
@@ -220,7 +232,7 @@ TEST(Protocol, ServerMessagesAreWellFormed) {
     EXPECT_EQ(hello["type"], "hello");
     EXPECT_EQ(hello["volume"]["dims"], json::array({9, 8, 7}));
     EXPECT_EQ(hello["accels"].size(), accel_names().size());
-    EXPECT_EQ(hello["renderers"], json::array({"march"}));
+    EXPECT_EQ(hello["renderers"], json::array({"march", "slice"}));
     EXPECT_EQ(hello["presets"].size(), preset_names().size());
     EXPECT_EQ(parse_transfer_function(hello["tf"].dump(), "hello"), preset("mr-brain"));
 

@@ -134,7 +134,7 @@ TEST(Server, HelloRenderAndErrorOverAWebSocket) {
     ASSERT_EQ(hello["type"], "hello");
     EXPECT_EQ(hello["volume"]["dims"], json::array({20, 18, 16}));
     EXPECT_EQ(hello["accels"].size(), accel_names().size());
-    EXPECT_EQ(hello["renderers"], json::array({"march"}));
+    EXPECT_EQ(hello["renderers"], json::array({"march", "slice"}));
     EXPECT_EQ(hello["histogram"].size(), size_t(FrameRenderer::kHistogramBins));
 
     // Malformed: answered with an error, the connection stays usable.
