@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "core/parallel.h"
+#include "lacuna/accel.h"
 #include "lacuna/error.h"
 #include "lacuna/segments.h"
 #include "lacuna/transfer_function.h"
@@ -32,15 +33,15 @@ void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
     so.tint = a.tint;
     so.leaf_cells = f.leaf;
     so.bitfield_bits = f.bits;
-    if (f.accel == "none")
-        so.skip = false;
-    else if (f.accel == "bitfield")
-        so.skip = true;
-    else
-        throw Error("--accel", "structure",
-                    "with segments expected 'none' or 'bitfield' (the label bitfield octree), got '" +
-                        f.accel + "'");
+    // bitfield: the label bitfield octree (labels + intensity bins); any other structure skips on
+    // the intensity alone (mask mode).
+    const AccelKind kind = parse_accel(f.accel);
+    so.skip = kind == AccelKind::Bitfield;
     const bool masked = so.mode == SegmentMode::Masked;
+    if (!masked && kind != AccelKind::None && kind != AccelKind::Bitfield)
+        throw Error("--accel", "structure",
+                    "the label volume alone takes 'none' or 'bitfield' (the label bitfield "
+                    "octree), got '" + f.accel + "'");
     if (masked && a.labels.empty())
         throw Error("--segments", "mode", "mask mode needs --labels FILE");
     if (masked && f.tf.empty()) throw Error("render", "--tf", "mask mode needs a transfer function");
@@ -61,7 +62,20 @@ void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
     Progress progress("building label octree");
     SegmentRenderer seg(masked ? &vol : nullptr, labels, so);
     progress.done();
-    if (masked) seg.set_transfer_function(discretise(*tf, vol.vis_range()));
+    std::unique_ptr<Accel> accel;
+    if (masked) {
+        const TransferLut lut = discretise(*tf, vol.vis_range());
+        seg.set_transfer_function(lut);
+        if (!so.skip && kind != AccelKind::None) {
+            AccelOptions ao;
+            ao.leaf_cells = f.leaf;
+            ao.bitfield_bits = f.bits;
+            ao.threads = f.ro.threads;
+            accel = make_accel(kind, vol, ao);
+            accel->set_transfer_function(lut);
+            seg.set_accel(accel.get());
+        }
+    }
     seg.set_labels(table);
     const Camera cam = Camera::orbit(seg.bounds(), f.op, f.w, f.h);
     const RenderResult r = seg.render(cam, f.ro);
@@ -71,7 +85,7 @@ void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
     for (const auto& s : table.styles) shown += s.visible && s.opacity > 0.f;
     std::printf("%s: %dx%d, segments %s, %d of %d labels visible, accel %s, %d threads\n",
                 f.volume.path.c_str(), f.w, f.h, to_string(so.mode).c_str(), shown,
-                table.size(), so.skip ? "label bitfield octree" : "none",
+                table.size(), so.skip ? "label bitfield octree" : f.accel.c_str(),
                 resolve_threads(f.ro.threads));
     if (so.skip)
         std::printf("label octree: build %.1f ms, %d bits per node, %.2f MiB, label change %.3f ms\n",

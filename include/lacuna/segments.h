@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "lacuna/accel.h"
 #include "lacuna/camera.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
@@ -92,6 +93,10 @@ public:
     void set_transfer_function(const TransferLut& lut);
     // Colours, opacities, visibility. Costs O(labels): no rebuild.
     void set_labels(const LabelTable& table);
+    // Mask mode without the label octree (options.skip == false): skip through any intensity
+    // structure instead (it must hold the current TF; nullptr: march every sample). Exact: it only
+    // drops samples whose TF opacity is zero, which the mask cannot raise.
+    void set_accel(const Accel* accel);
     RenderResult render(const Camera& camera, const RenderOptions& options) const;
     Box3f bounds() const;
     const SegmentStats& stats() const { return m_stats; }

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "accel/accel_impl.h"
 #include "accel/label_octree.h"
 #include "accel/no_accel.h"
 #include "core/parallel.h"
@@ -25,6 +26,7 @@ struct SegmentRenderer::Impl {
     const Volume& labels;
     SegmentOptions opts;
     std::unique_ptr<LabelOctree> octree;
+    const Accel* accel = nullptr;  // mask mode without the octree: an intensity structure
     TransferLut lut;
     // Per label: labels mode premultiplied colour and opacity per unit distance (step-corrected
     // at render time); masked mode colour and opacity factor (0 when hidden).
@@ -199,6 +201,13 @@ void SegmentRenderer::set_labels(const LabelTable& t) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+void SegmentRenderer::set_accel(const Accel* accel) {
+    if (accel && (m_impl->octree || m_impl->opts.mode != SegmentMode::Masked))
+        throw Error("--accel", "segments",
+                    "an intensity structure applies to mask mode without the label octree");
+    m_impl->accel = accel;
+}
+
 Box3f SegmentRenderer::bounds() const { return {{0, 0, 0}, m_impl->labels.world_extent()}; }
 
 RenderResult SegmentRenderer::render(const Camera& cam, const RenderOptions& opt) const {
@@ -239,6 +248,8 @@ RenderResult SegmentRenderer::render(const Camera& cam, const RenderOptions& opt
                 };
                 if (im.octree)
                     run(*im.octree);
+                else if (im.accel)
+                    visit_accel(*im.accel, run);
                 else
                     run(NoAccel{});
             }

@@ -172,6 +172,38 @@ TEST(Segments, OctreeSkippingIsByteIdenticalToMarchingEverySample) {
     }
 }
 
+TEST(Segments, MaskModeIsExactThroughEveryIntensityStructure) {
+    Rng rng{31};
+    for (int trial = 0; trial < 4; ++trial) {
+        const Vec3i d{rng.range(6, 26), rng.range(6, 26), rng.range(6, 26)};
+        const Volume lab = random_labels(d, VoxelType::UInt8, rng.range(1, 150), rng);
+        const Volume inten = random_intensity(d, rng);
+        const TransferLut lut = random_lut(inten.vis_range(), rng);
+        const LabelTable t = random_table(lab, rng);
+        SegmentOptions so;
+        so.skip = false;
+        so.tint = rng.uniform();
+        SegmentRenderer seg(&inten, lab, so);
+        seg.set_transfer_function(lut);
+        seg.set_labels(t);
+        RenderOptions ro;
+        ro.keep_float = ro.count_samples = true;
+        ro.ert = rng.coin() ? 0.99f : 2.f;
+        const Camera cam = random_camera(inten, rng, 30);
+        const RenderResult ref = seg.render(cam, ro);
+        for (AccelKind k : all_accel_kinds()) {
+            if (k == AccelKind::None) continue;
+            auto accel = make_accel(k, inten);
+            accel->set_transfer_function(lut);
+            seg.set_accel(accel.get());
+            const RenderResult r = seg.render(cam, ro);
+            seg.set_accel(nullptr);
+            expect_same(r, ref, "trial " + std::to_string(trial) + " accel " + to_string(k));
+            ASSERT_LE(r.stats.samples, ref.stats.samples) << to_string(k);
+        }
+    }
+}
+
 TEST(Segments, MaskWithEveryLabelVisibleIsTheRayMarcherToTheBit) {
     Rng rng{99};
     for (int trial = 0; trial < 6; ++trial) {
