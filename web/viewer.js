@@ -21,6 +21,8 @@
     ert: true,
     shading: false,
     clip: false,
+    segments: false,
+    hide: '',
     step: 0.5,
     // TF in the normalized domain: x in [0,1] across the volume's visualization range (or
     // tf.range when set). color: [x, r, g, b]; opacity: [x, a].
@@ -71,6 +73,8 @@
     state.renderer = $('renderer').value;
     fillSelect($('accel'), msg.accels, msg.accels.includes('bitfield') ? 'bitfield' : msg.accels[0]);
     state.accel = $('accel').value;
+    // Segments only when the server loaded a label volume (`lacuna serve ... --labels FILE`).
+    $('segments-row').hidden = !(msg.labels > 0);
     const presets = $('preset');
     for (const name of Object.keys(msg.presets)) {
       const o = document.createElement('option');
@@ -131,6 +135,7 @@
       type: 'render', id, width: w, height: h, preview: dirtyPreview,
       camera: state.camera, renderer: state.renderer, accel: state.accel,
       ert: state.ert, step: state.step, tf: state.tf, shading: state.shading, clip: state.clip,
+      segments: state.segments, hide: state.hide,
     }));
     inFlight = id;
     dirty = false;
@@ -241,6 +246,8 @@
       $('accel').value = state.accel;
       state.shading = state.clip = false;
       $('shading').checked = $('clip').checked = false;
+      state.segments = false;
+      $('segments').checked = false;
     }
     request(false);
   });
@@ -254,8 +261,20 @@
     request(false);
   });
   $('ert').addEventListener('change', (e) => { state.ert = e.target.checked; request(false); });
-  $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; if (state.shading) marchIfSlicer(); request(false); });
-  $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; if (state.clip) marchIfSlicer(); request(false); });
+  // Segments are drawn by the marcher without shading or clipping: the toggles exclude each other.
+  const noSegments = () => { state.segments = false; $('segments').checked = false; };
+  $('segments').addEventListener('change', (e) => {
+    state.segments = e.target.checked;
+    if (state.segments) {
+      marchIfSlicer();
+      state.shading = state.clip = false;
+      $('shading').checked = $('clip').checked = false;
+    }
+    request(false);
+  });
+  $('hide').addEventListener('change', (e) => { state.hide = e.target.value.trim(); request(false); });
+  $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; if (state.shading) { marchIfSlicer(); noSegments(); } request(false); });
+  $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; if (state.clip) { marchIfSlicer(); noSegments(); } request(false); });
   $('step').addEventListener('input', (e) => {
     state.step = Number(e.target.value);
     $('step-value').textContent = e.target.value;

@@ -20,6 +20,7 @@ struct ServeArgs {
     std::string tf;
     int threads = 0;
     int leaf = 8, bits = 64;
+    std::string labels;  // label volume for the segments toggle
 };
 
 void run(const ServeArgs& a) {
@@ -38,6 +39,11 @@ void run(const ServeArgs& a) {
     ao.leaf_cells = a.leaf;
     ao.bitfield_bits = a.bits;
     serve::FrameRenderer renderer(std::move(vol), ao, a.threads);
+    if (!a.labels.empty()) {
+        VolumeArgs la;
+        la.path = a.labels;
+        renderer.set_labels(load_volume(la));
+    }
     serve::Server server(renderer, so);
     server.start();
     if (a.host != "127.0.0.1" && a.host != "::1")
@@ -56,6 +62,8 @@ void register_serve(CLI::App& app) {
     auto a = std::make_shared<ServeArgs>();
     auto* cmd = app.add_subcommand("serve", "Interactive viewer in the browser (docs/viewer.md)");
     add_volume_args(*cmd, a->volume);
+    cmd->add_option("--labels", a->labels,
+                    "Label volume (same dims) for the page's segments toggle (docs/segments.md)");
     cmd->add_option(
            "--host", a->host,
            "Address to listen on (default loopback only; another address exposes the viewer)")

@@ -172,8 +172,69 @@ Frame FrameRenderer::render_slice(const ViewRequest& req, int width, int height)
     return f;
 }
 
+void FrameRenderer::set_labels(Volume labels) {
+    check_label_volume(labels, m_volume.get(), "--labels");
+    m_labels = std::make_unique<Volume>(std::move(labels));
+    m_label_table = default_label_table(*m_labels);
+    for (auto& s : m_segments) s = {};
+}
+
+Frame FrameRenderer::render_segments(const ViewRequest& req, int width, int height) {
+    Frame f;
+    const auto t0 = Clock::now();
+    if (!m_has_tf || !(req.tf == m_tf)) {
+        m_tf = req.tf;
+        m_has_tf = true;
+        ++m_tf_version;
+        m_lut = discretise(m_tf, m_volume->vis_range());
+        m_marcher->set_transfer_function(m_lut);
+        f.tf_changed = true;
+    }
+    const bool octree = req.accel == AccelKind::Bitfield;
+    BuiltSegments& b = m_segments[octree ? 1 : 0];
+    if (!b.renderer) {
+        const auto tb = Clock::now();
+        SegmentOptions so;
+        so.skip = octree;
+        so.leaf_cells = m_accel_options.leaf_cells;
+        so.bitfield_bits = m_accel_options.bitfield_bits;
+        b.renderer = std::make_unique<SegmentRenderer>(m_volume.get(), *m_labels, so);
+        f.accel_build_seconds = seconds_since(tb);
+    }
+    if (b.tf_version != m_tf_version) {
+        b.renderer->set_transfer_function(m_lut);
+        b.tf_version = m_tf_version;
+    }
+    if (!octree) {
+        const Accel* a = nullptr;
+        if (req.accel != AccelKind::None) {
+            Accel& acc = accel(req.accel, f.accel_build_seconds);
+            Built& built = m_accels[req.accel];
+            if (built.tf_version != m_tf_version) {
+                acc.set_transfer_function(m_lut);
+                built.tf_version = m_tf_version;
+            }
+            a = &acc;
+        }
+        b.renderer->set_accel(a);
+    }
+    if (f.tf_changed) f.tf_update_seconds = seconds_since(t0);
+    LabelTable t = m_label_table;
+    if (!req.hide.empty()) set_label_visibility(t, req.hide, false, "hide");
+    b.renderer->set_labels(t);
+    const Camera cam = camera(req.camera, width, height);
+    const RenderOptions ro = render_options(req);
+    RenderResult r = b.renderer->render(cam, ro);
+    f.image = std::move(r.image);
+    f.stats = r.stats;
+    f.lattice_samples = lattice_samples(*m_volume, cam, ro.step, m_threads);
+    f.skipped = f.lattice_samples ? 1.0 - double(f.stats.samples) / double(f.lattice_samples) : 0.0;
+    return f;
+}
+
 Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     if (req.renderer == RendererKind::Slice) return render_slice(req, width, height);
+    if (req.segments && m_labels) return render_segments(req, width, height);
     Frame f;
     // 1. A new TF: discretise it and hand it to the marcher and the current structure (the
     //    "TF change -> ready to render" time of the bitfield paper, Section 4.5).

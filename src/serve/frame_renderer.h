@@ -14,6 +14,7 @@
 #include "lacuna/accel.h"
 #include "lacuna/camera.h"
 #include "lacuna/renderer.h"
+#include "lacuna/segments.h"
 #include "lacuna/volume.h"
 #include "serve/protocol.h"
 #include "slice/box_source.h"
@@ -41,6 +42,10 @@ class FrameRenderer {
     FrameRenderer& operator=(const FrameRenderer&) = delete;
 
     const Volume& volume() const { return *m_volume; }
+    // A label volume (same dims) for the page's segments toggle (docs/segments.md). Throws
+    // lacuna::Error if it cannot be a label map of this volume.
+    void set_labels(Volume labels);
+    int label_count() const { return m_labels ? m_label_table.size() : 0; }
     // Voxel counts in kHistogramBins equal bins over the visualization range.
     static constexpr int kHistogramBins = 256;
     const std::vector<uint64_t>& histogram() const { return m_histogram; }
@@ -74,6 +79,16 @@ class FrameRenderer {
     };
     std::map<AccelKind, BuiltSource> m_sources;
     Frame render_slice(const ViewRequest& req, int width, int height);
+    // Segments: the intensity masked by the labels; with accel bitfield the label bitfield octree,
+    // otherwise the intensity structure.
+    std::unique_ptr<Volume> m_labels;
+    LabelTable m_label_table;  // defaults (colours, 0 hidden)
+    struct BuiltSegments {
+        std::unique_ptr<SegmentRenderer> renderer;
+        uint64_t tf_version = 0;
+    };
+    BuiltSegments m_segments[2];  // [0]: intensity structures, [1]: label octree
+    Frame render_segments(const ViewRequest& req, int width, int height);
     bool m_has_tf = false;
     TransferFunction m_tf;
     TransferLut m_lut;

@@ -1,5 +1,7 @@
 #include "serve/protocol.h"
 
+#include "lacuna/segments.h"
+
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -131,7 +133,7 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     if (type != "render") reject("type", "unknown message type '" + type + "'; expected render");
     only_keys(j,
               {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
-               "step", "tf", "shading", "clip"},
+               "step", "tf", "shading", "clip", "segments", "hide"},
               "");
     ViewRequest r;
     r.id = id_of(j);
@@ -168,6 +170,21 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     // the volume's centre that removes the half with x > centre (a cut-away of a head).
     if (j.contains("shading")) r.shading = boolean(j, "shading", "");
     if (j.contains("clip")) r.clip = boolean(j, "clip", "");
+    if (j.contains("segments")) r.segments = boolean(j, "segments", "");
+    if (j.contains("hide")) {
+        r.hide = text_of(j, "hide", "");
+        if (r.hide.size() > 256) reject("hide", "expected at most 256 characters");
+        if (!r.hide.empty()) {
+            LabelTable check;
+            try {
+                set_label_visibility(check, r.hide, false, "hide");
+            } catch (const Error& e) {
+                reject("hide", e.what());
+            }
+        }
+    }
+    if (r.segments && (r.shading || r.clip || r.renderer == RendererKind::Slice))
+        reject("segments", "segments are drawn by the ray marcher without shading or clipping");
     if (r.renderer == RendererKind::Slice) {
         if (r.accel != AccelKind::None && r.accel != AccelKind::KdTree)
             reject("accel", "the slice renderer takes none (Basic) or kdtree, not '" +
@@ -216,6 +233,7 @@ std::string hello_message(const HelloInfo& h) {
     j["tf"] = json::parse(to_json(h.initial_tf));
     j["accels"] = h.accels;
     j["renderers"] = h.renderers;
+    j["labels"] = h.labels;
     j["limits"] = {{"max_message_bytes", h.limits.max_message_bytes},
                    {"max_side", h.limits.max_side},
                    {"max_tf_points", h.limits.max_tf_points}};

@@ -6,7 +6,7 @@
 //   {"type":"render", "id":N, "width":W, "height":H, "preview":bool,
 //    "camera":{"azimuth":deg, "elevation":deg, "zoom":f, "pan":[x,y]},
 //    "renderer":"march", "accel":"bitfield", "ert":bool, "step":f,
-//    ["shading":bool, "clip":bool,]  (optional toggles, off when absent)
+//    ["shading":bool, "clip":bool, "segments":bool, "hide":"1,2,37-42"]  (optional, off when absent)
 //    "tf":{...the transfer-function JSON of docs/transfer-functions.md...}}
 //   Every request carries the whole view state, so the server can drop all but the latest.
 //   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
@@ -61,6 +61,8 @@ struct ViewRequest {
     float step = 0.5f;  // sample distance in smallest voxel spacings, [0.1, 8]
     bool shading = false;  // optional "shading": Phong with a headlight (docs/shading.md)
     bool clip = false;     // optional "clip": keep x <= the volume's centre (a cut-away)
+    bool segments = false;  // optional "segments": mask by the server's label volume (--labels)
+    std::string hide;       // optional "hide": labels to hide, "1,2,37-42" (docs/segments.md)
     TransferFunction tf;
 };
 
@@ -76,6 +78,7 @@ struct HelloInfo {
     std::vector<uint64_t> histogram;  // bins over the visualization range
     TransferFunction initial_tf;      // the TF the page starts with
     std::vector<std::string> accels, renderers;
+    int labels = 0;  // label values of the server's label volume (0: none loaded)
     Limits limits;
 };
 std::string hello_message(const HelloInfo& h);

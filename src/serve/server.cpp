@@ -427,6 +427,7 @@ Server::Server(FrameRenderer& renderer, ServerOptions options)
     h.initial_tf = m->options.initial_tf;
     h.accels = accel_names();
     h.renderers = renderer_names();
+    h.labels = renderer.label_count();
     h.limits = m->options.limits;
     m->hello = hello_message(h);
 }

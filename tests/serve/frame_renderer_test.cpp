@@ -100,6 +100,33 @@ TEST(FrameRenderer, SliceRendererFramesAreTheCliSlicer) {
     }
 }
 
+TEST(FrameRenderer, SegmentFramesAreTheCliSegments) {
+    SyntheticOptions so;
+    so.dims = {33, 30, 27};
+    so.seed = 5;
+    const fs::path labels = temp_dir() / "labels.nrrd";
+    write_volume(labels.string(), generate(SyntheticKind::NoiseBlobs, so));
+    FrameRenderer fr(read_volume(shells_file().string()));
+    fr.set_labels(read_volume(labels.string()));
+    EXPECT_GT(fr.label_count(), 1);
+    for (const char* accel : {"bitfield", "minmax", "none"}) {
+        const fs::path out = temp_dir() / (std::string("cli_seg_") + accel + ".png");
+        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " +
+                                shells_file().string() + " --labels " + labels.string() +
+                                " --hide 1-100 --tf mr-default --accel " + accel +
+                                " --width 40 --height 36 --azimuth 40 --elevation 20 --zoom 1.3"
+                                " --step 0.5 --ert 1 --out " + out.string() + " >/dev/null";
+        const int status = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+        ViewRequest req = request(parse_accel(accel), "mr-default");
+        req.segments = true;
+        req.hide = "1-100";
+        EXPECT_EQ(fr.render(req, 40, 36).image.rgba, read_png(out.string()).rgba) << accel;
+    }
+    Volume wrong({4, 4, 4}, VoxelType::UInt8);
+    EXPECT_THROW(fr.set_labels(std::move(wrong)), Error);
+}
+
 TEST(FrameRenderer, ShadingAndClipTogglesAreTheCliFlags) {
     // The page's toggles: Phong with the headlight, and the plane keeping x <= the centre (16 mm
     // for the 33-voxel-wide shells at 1 mm).

@@ -78,6 +78,23 @@ TEST(Protocol, TheSliceRendererTakesNoneOrKdtreeAndNoFeatures) {
     expect_rejected(j, "renderer");
 }
 
+TEST(Protocol, ParsesTheSegmentsToggleAndItsHiddenLabels) {
+    json j = good_request();
+    j["segments"] = true;
+    j["hide"] = "1-28,40";
+    const ViewRequest r = parse_request(j.dump());
+    EXPECT_TRUE(r.segments);
+    EXPECT_EQ(r.hide, "1-28,40");
+    j["hide"] = "1-x";
+    expect_rejected(j, "hide");
+    j["hide"] = 3;
+    expect_rejected(j, "hide");
+    j = good_request();
+    j["segments"] = true;
+    j["shading"] = true;
+    expect_rejected(j, "segments");
+}
+
 TEST(Protocol, ParsesTheOptionalShadingAndClipToggles) {
     json j = good_request();
     j["shading"] = true;
