@@ -128,18 +128,21 @@ Accel& FrameRenderer::accel(AccelKind k, double& build_seconds) {
     return *b.accel;
 }
 
+bool FrameRenderer::update_tf(const TransferFunction& tf) {
+    if (m_has_tf && tf == m_tf) return false;
+    m_tf = tf;
+    m_has_tf = true;
+    ++m_tf_version;
+    m_lut = discretise(m_tf, m_volume->vis_range());
+    m_marcher->set_transfer_function(m_lut);
+    return true;
+}
+
 Frame FrameRenderer::render_slice(const ViewRequest& req, int width, int height) {
     Frame f;
     const auto t0 = Clock::now();
     if (!m_slicer) m_slicer = std::make_unique<SliceRenderer>(*m_volume);
-    if (!m_has_tf || !(req.tf == m_tf)) {
-        m_tf = req.tf;
-        m_has_tf = true;
-        ++m_tf_version;
-        m_lut = discretise(m_tf, m_volume->vis_range());
-        m_marcher->set_transfer_function(m_lut);
-        f.tf_changed = true;
-    }
+    f.tf_changed = update_tf(req.tf);
     m_slicer->set_transfer_function(m_lut);
     BuiltSource& b = m_sources[req.accel];
     if (!b.source) {
@@ -182,14 +185,7 @@ void FrameRenderer::set_labels(Volume labels) {
 Frame FrameRenderer::render_segments(const ViewRequest& req, int width, int height) {
     Frame f;
     const auto t0 = Clock::now();
-    if (!m_has_tf || !(req.tf == m_tf)) {
-        m_tf = req.tf;
-        m_has_tf = true;
-        ++m_tf_version;
-        m_lut = discretise(m_tf, m_volume->vis_range());
-        m_marcher->set_transfer_function(m_lut);
-        f.tf_changed = true;
-    }
+    f.tf_changed = update_tf(req.tf);
     const bool octree = req.accel == AccelKind::Bitfield;
     BuiltSegments& b = m_segments[octree ? 1 : 0];
     if (!b.renderer) {
@@ -241,14 +237,7 @@ Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     Accel& a = accel(req.accel, f.accel_build_seconds);
     Built& built = m_accels[req.accel];
     const auto t0 = Clock::now();
-    if (!m_has_tf || !(req.tf == m_tf)) {
-        m_tf = req.tf;
-        m_has_tf = true;
-        ++m_tf_version;
-        m_lut = discretise(m_tf, m_volume->vis_range());
-        m_marcher->set_transfer_function(m_lut);
-        f.tf_changed = true;
-    }
+    f.tf_changed = update_tf(req.tf);
     // 2. A structure that missed TF changes (it was not selected then) catches up.
     if (built.tf_version != m_tf_version) {
         a.set_transfer_function(m_lut);

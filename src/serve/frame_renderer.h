@@ -78,6 +78,9 @@ class FrameRenderer {
         uint64_t tf_version = 0;
     };
     std::map<AccelKind, BuiltSource> m_sources;
+    // A new TF (different from the last one): discretise it and hand it to the marcher; bumps
+    // m_tf_version so structures, box sources and segment renderers catch up. True if it changed.
+    bool update_tf(const TransferFunction& tf);
     Frame render_slice(const ViewRequest& req, int width, int height);
     // Segments: the intensity masked by the labels; with accel bitfield the label bitfield octree,
     // otherwise the intensity structure.

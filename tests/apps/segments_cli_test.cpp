@@ -1,7 +1,8 @@
 // `lacuna render --labels/--segments` end to end: the octree and the unskipped render write the
 // same PNG; bad label inputs give one line, exit code 2 and no output file.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+
+#include "apps/cli_run.h"
 
 #include <filesystem>
 #include <fstream>
@@ -13,28 +14,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
+using lacuna::test::CliResult;
 
-CliRun lacuna(const std::string& args) {
-    const fs::path dir = fs::temp_directory_path() / ("lacuna-seg-" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" +
-                            (dir / "o").string() + " 2>" + (dir / "e").string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    CliRun r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    auto slurp = [](const fs::path& p) {
-        std::ifstream f(p);
-        std::stringstream s;
-        s << f.rdbuf();
-        return s.str();
-    };
-    r.out = slurp(dir / "o");
-    r.err = slurp(dir / "e");
-    return r;
+CliResult lacuna(const std::string& args) {
+    return lacuna::test::run_cli(args, lacuna::test::cli_temp_dir("seg"));
 }
 
 std::string bytes(const fs::path& p) {
@@ -56,8 +39,8 @@ TEST(SegmentsCli, OctreeAndUnskippedRendersWriteTheSamePngAndBadInputExits2) {
     for (const std::string& mode : std::vector<std::string>{"--labels " + lab + " --tf mr-default", "--segments labels"}) {
         const std::string base = (mode[2] == 's' ? lab : vol) + " " + mode +
                                  " --hide 1-40 --size 40 --azimuth 70 --out ";
-        const CliRun a = lacuna("render " + base + (d / "a.png").string() + " --accel none");
-        const CliRun b = lacuna("render " + base + (d / "b.png").string() + " --accel bitfield");
+        const CliResult a = lacuna("render " + base + (d / "a.png").string() + " --accel none");
+        const CliResult b = lacuna("render " + base + (d / "b.png").string() + " --accel bitfield");
         ASSERT_EQ(a.code, 0) << a.err;
         ASSERT_EQ(b.code, 0) << b.err;
         EXPECT_NE(b.out.find("label octree: build"), std::string::npos) << b.out;
@@ -77,7 +60,7 @@ TEST(SegmentsCli, OctreeAndUnskippedRendersWriteTheSamePngAndBadInputExits2) {
     };
     for (const auto& [args, needle] : bad) {
         const fs::path out = d / "bad.png";
-        const CliRun r = lacuna(args + " --size 16 --out " + out.string());
+        const CliResult r = lacuna(args + " --size 16 --out " + out.string());
         EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
         EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

@@ -2,7 +2,8 @@
 // good runs write a PNG that is the same for every --accel; malformed values give one line
 // naming the flag, exit code 2, and no output file.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+
+#include "apps/cli_run.h"
 
 #include <filesystem>
 #include <fstream>
@@ -13,38 +14,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
+using CliRun = lacuna::test::CliResult;
+std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
 
-fs::path temp_dir() {
-    static fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("lacuna-shading-cli-" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
-    return dir;
-}
+fs::path temp_dir() { return lacuna::test::cli_temp_dir("shading-cli"); }
 
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
-CliRun run(const std::string& args) {
-    const fs::path out = temp_dir() / "stdout.txt", err = temp_dir() / "stderr.txt";
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" + out.string() + " 2>" +
-                            err.string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    CliRun r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
+CliRun run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
 
 const fs::path& volume() {
     static fs::path p = [] {

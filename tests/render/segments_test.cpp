@@ -10,6 +10,7 @@
 
 #include "accel/label_octree.h"
 #include "common/rng.h"
+#include "conformance/conformance_util.h"
 #include "lacuna/error.h"
 #include "lacuna/io.h"
 #include "lacuna/renderer.h"
@@ -20,6 +21,7 @@ namespace lacuna {
 namespace {
 
 using test::Rng;
+using test::random_camera;
 namespace fs = std::filesystem;
 
 // Label blobs: a few random boxes of random labels over background 0 (runs and boundaries like
@@ -55,7 +57,9 @@ Volume random_intensity(Vec3i d, Rng& rng) {
     return generate(SyntheticKind::NoiseBlobs, so);
 }
 
-TransferLut random_lut(ValueRange vis, Rng& rng) {
+// Wider opacity bumps than conformance_util.h's random_lut (up to 400 entries): masked
+// renders need visible content under most labels.
+TransferLut wide_random_lut(ValueRange vis, Rng& rng) {
     TransferLut lut;
     lut.vis = vis;
     lut.entries.assign(kDefaultLutSize, Rgba{});
@@ -66,23 +70,6 @@ TransferLut random_lut(ValueRange vis, Rng& rng) {
             lut.entries[size_t(e)] = {rng.uniform(), rng.uniform(), rng.uniform(), a};
     }
     return lut;
-}
-
-Camera random_camera(const Volume& v, Rng& rng, int size) {
-    OrbitParams p;
-    p.azimuth_deg = 360.f * rng.uniform();
-    p.elevation_deg = -80.f + 160.f * rng.uniform();
-    p.projection = rng.range(0, 3) == 0 ? Projection::Orthographic : Projection::Perspective;
-    const Box3f b{{0, 0, 0}, v.world_extent()};
-    if (p.projection == Projection::Perspective && rng.range(0, 2) == 0) {
-        p.has_target = true;  // inside the volume
-        p.target = {b.hi.x * rng.uniform(), b.hi.y * rng.uniform(), b.hi.z * rng.uniform()};
-        p.distance = 0.05f + 0.3f * length(b.extent()) * rng.uniform();
-        p.fov_y_deg = 40.f + 60.f * rng.uniform();
-    } else {
-        p.zoom = 0.7f + 2.f * rng.uniform();
-    }
-    return Camera::orbit(b, p, size, size);
 }
 
 LabelTable random_table(const Volume& labels, Rng& rng) {
@@ -152,7 +139,7 @@ TEST(Segments, OctreeSkippingIsByteIdenticalToMarchingEverySample) {
         SegmentOptions ref_opts = so;
         ref_opts.skip = false;
         SegmentRenderer ref(in, lab, ref_opts), fast(in, lab, so);
-        const TransferLut lut = random_lut(inten.vis_range(), rng);
+        const TransferLut lut = wide_random_lut(inten.vis_range(), rng);
         if (in) ref.set_transfer_function(lut), fast.set_transfer_function(lut);
         RenderOptions ro;
         ro.keep_float = ro.count_samples = true;
@@ -178,7 +165,7 @@ TEST(Segments, MaskModeIsExactThroughEveryIntensityStructure) {
         const Vec3i d{rng.range(6, 26), rng.range(6, 26), rng.range(6, 26)};
         const Volume lab = random_labels(d, VoxelType::UInt8, rng.range(1, 150), rng);
         const Volume inten = random_intensity(d, rng);
-        const TransferLut lut = random_lut(inten.vis_range(), rng);
+        const TransferLut lut = wide_random_lut(inten.vis_range(), rng);
         const LabelTable t = random_table(lab, rng);
         SegmentOptions so;
         so.skip = false;
@@ -210,7 +197,7 @@ TEST(Segments, MaskWithEveryLabelVisibleIsTheRayMarcherToTheBit) {
         const Vec3i d{rng.range(6, 30), rng.range(6, 30), rng.range(6, 30)};
         const Volume lab = random_labels(d, VoxelType::UInt8, 40, rng);
         const Volume inten = random_intensity(d, rng);
-        const TransferLut lut = random_lut(inten.vis_range(), rng);
+        const TransferLut lut = wide_random_lut(inten.vis_range(), rng);
         LabelTable t = default_label_table(lab);
         for (auto& s : t.styles) s.visible = true, s.opacity = 1.f;
         SegmentOptions so;
