@@ -37,26 +37,23 @@ void BitfieldOctree::build() {
     for (int w = 0; w < 2; ++w)
         for (int b = 0; b <= 129; ++b) below[w][b] = b <= 64 * w ? 0 : range_mask(64 * w, b - 1, w);
     const int B = 1 << m_pyr.leaf_log2;
-    for_each_cell_row(m_volume, m_map, B, m_opts.threads, [&](const CellRow& r) {
+    for_each_cell_chunk_row(m_volume, m_map, B, m_opts.threads, [&](const CellChunkRow& r) {
         uint64_t* leaf =
             &m_bits[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2) * size_t(W)];
-        for (int i0 = 0; i0 < r.n; i0 += B, leaf += W) {
-            const int i1 = std::min(r.n, i0 + B);
-            // Common in sparse data: every cell of the chunk in one bin range [lo, hi].
-            uint16_t lo = r.lo[i0], hi = r.hi[i0];
-            for (int i = i0; i < i1; ++i) {
-                lo = std::min(lo, r.lo[i]);
-                hi = std::max(hi, r.hi[i]);
-            }
-            if (bin_of[lo] == bin_of[hi]) {
-                const int b = bin_of[lo];
-                leaf[b >> 6 < W ? b >> 6 : 0] |= uint64_t(1) << (b & 63);
+        uint16_t lo[64], hi[64];
+        for (int q = 0, i0 = 0; i0 < r.n; ++q, i0 += B, leaf += W) {
+            // Common in sparse data: every cell of the chunk in one bin.
+            const int c0 = bin_of[r.chunk_lo[q]], c1 = bin_of[r.chunk_hi[q]];
+            if (c0 == c1) {
+                leaf[c0 >> 6 < W ? c0 >> 6 : 0] |= uint64_t(1) << (c0 & 63);
                 continue;
             }
+            const int i1 = std::min(r.n, i0 + B);
+            r.cells(i0, i1, lo, hi);
             for (int w = 0; w < W; ++w) {
                 uint64_t acc = leaf[w];
-                for (int i = i0; i < i1; ++i) {
-                    const int b0 = bin_of[r.lo[i]], b1 = bin_of[r.hi[i]];
+                for (int i = 0; i < i1 - i0; ++i) {
+                    const int b0 = bin_of[lo[i]], b1 = bin_of[hi[i]];
                     acc |= below[w][b1 + 1] ^ below[w][b0];
                 }
                 leaf[w] = acc;

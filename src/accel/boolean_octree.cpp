@@ -19,13 +19,17 @@ void BooleanOctree::set_transfer_function(const TransferLut& lut) {
     prefix.build(lut);
     std::fill(m_occupied.begin(), m_occupied.end(), 0);
     const int B = 1 << m_pyr.leaf_log2;
-    for_each_cell_row(m_volume, m_map, B, m_opts.threads, [&](const CellRow& r) {
+    for_each_cell_chunk_row(m_volume, m_map, B, m_opts.threads, [&](const CellChunkRow& r) {
         uint8_t* leaf = &m_occupied[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2)];
-        for (int i0 = 0; i0 < r.n; i0 += B, ++leaf) {
-            if (*leaf) continue;
+        uint16_t lo[64], hi[64];
+        for (int q = 0, i0 = 0; i0 < r.n; ++q, i0 += B, ++leaf) {
+            // A chunk whose union is invisible has no visible cell; otherwise ask each cell
+            // (the union can span an opaque gap no single cell reaches).
+            if (*leaf || !prefix.visible(r.chunk_lo[q], r.chunk_hi[q])) continue;
             const int i1 = std::min(r.n, i0 + B);
+            r.cells(i0, i1, lo, hi);
             uint8_t occ = 0;
-            for (int i = i0; i < i1 && !occ; ++i) occ = prefix.visible(r.lo[i], r.hi[i]);
+            for (int i = 0; i < i1 - i0 && !occ; ++i) occ = prefix.visible(lo[i], hi[i]);
             *leaf = occ;
         }
     });

@@ -133,14 +133,37 @@ void reduce_plane(const V* in, V* out, int vx, int vy) {
     }
 }
 
+// Per chunk of `chunk` values of one row the min (or max): passes of pairwise op at doubling
+// distance over a padded copy (plain loops the compiler vectorises) until tmp[i] covers the
+// p = largest power of two <= chunk values from i; then chunk q is op(tmp[q*chunk],
+// tmp[q*chunk + chunk - p]) (two overlapping windows, as in a sparse table). tmp holds n rounded
+// up to chunks plus one chunk.
+template <bool Max, class V>
+void chunk_reduce(const V* in, V* __restrict out, int n, int chunk, V* __restrict tmp) {
+    const int nq = (n + chunk - 1) / chunk, len = nq * chunk;
+    const V neutral = Max ? std::numeric_limits<V>::lowest() : std::numeric_limits<V>::max();
+    std::copy(in, in + n, tmp);
+    std::fill(tmp + n, tmp + len + chunk, neutral);
+    int p = 1;
+    for (; 2 * p <= chunk; p *= 2)
+        for (int i = 0; i < len; ++i)
+            tmp[i] = Max ? std::max(tmp[i], tmp[i + p]) : std::min(tmp[i], tmp[i + p]);
+    const int off = chunk - p;
+    for (int q = 0; q < nq; ++q) {
+        const V a = tmp[size_t(q) * chunk], b = tmp[size_t(q) * chunk + off];
+        out[q] = Max ? std::max(a, b) : std::min(a, b);
+    }
+}
+
 // Streams cells row by row; every voxel plane is reduced once (2x2 pairs in the plane, then
 // pairs of planes). Integer voxels: the reduction runs on the raw values and only each cell's
 // min and max corner are mapped to LUT entries (the voxel bounds are monotone in the value, so
 // the lowest lower bound is that of the smallest corner: same answer, half the memory traffic
 // and a quarter of the table lookups). Float voxels map every voxel first (NaN-free order).
-template <class T>
-void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int threads,
-                const std::function<void(const CellRow&)>& fn) {
+// Chunked (chunk > 0): per row the chunk unions, cells mapped only when asked for (CellChunkRow).
+template <class T, class Fn>
+void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int chunk, int threads,
+                const Fn& fn) {
     const Vec3i d = v.dims();
     const int cz = d.z - 1, cx = d.x - 1, cy = d.y - 1;
     const int nslabs = (cz + slab - 1) / slab;
@@ -148,12 +171,19 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
     constexpr bool kRaw = VoxelLut<T>::kTable;
     using V = std::conditional_t<kRaw, T, uint16_t>;  // type of the reduced planes
     const size_t plane = size_t(d.x) * size_t(d.y), cplane = size_t(cx) * size_t(cy);
+    const int nchunks = chunk > 0 ? (cx + chunk - 1) / chunk : 0;
     parallel_for(size_t(nslabs), threads, [&](size_t s0, size_t s1) {
         std::vector<uint16_t> vlo(kRaw ? 0 : plane), vhi(kRaw ? 0 : plane);
         // Reduced planes of the current pair of voxel planes (ping-pong) and the cell layer.
         std::vector<V> plo[2] = {std::vector<V>(cplane), std::vector<V>(cplane)};
         std::vector<V> phi[2] = {std::vector<V>(cplane), std::vector<V>(cplane)};
         std::vector<uint16_t> clo(static_cast<size_t>(cx)), chi(static_cast<size_t>(cx));
+        // Chunked: per plane and row the chunk min/max of the in-plane reduction (ping-pong).
+        const size_t qplane = size_t(nchunks) * size_t(cy);
+        std::vector<V> pqlo[2] = {std::vector<V>(qplane), std::vector<V>(qplane)};
+        std::vector<V> pqhi[2] = {std::vector<V>(qplane), std::vector<V>(qplane)};
+        std::vector<V> tmp(chunk > 0 ? size_t(nchunks + 1) * size_t(chunk) : 0);
+        std::vector<uint16_t> qlo(static_cast<size_t>(nchunks)), qhi(static_cast<size_t>(nchunks));
         auto load = [&](int z, int slot) {
             const T* src = data + size_t(z) * plane;
             if constexpr (kRaw) {
@@ -163,6 +193,31 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
                 for (size_t i = 0; i < plane; ++i) vl.bounds(src[i], vlo[i], vhi[i]);
                 reduce_plane<false>(vlo.data(), plo[slot].data(), d.x, d.y);
                 reduce_plane<true>(vhi.data(), phi[slot].data(), d.x, d.y);
+            }
+            if (chunk > 0)
+                for (int j = 0; j < cy; ++j) {
+                    const size_t r = size_t(j) * cx, q = size_t(j) * nchunks;
+                    chunk_reduce<false>(plo[slot].data() + r, pqlo[slot].data() + q, cx, chunk,
+                                        tmp.data());
+                    chunk_reduce<true>(phi[slot].data() + r, pqhi[slot].data() + q, cx, chunk,
+                                       tmp.data());
+                }
+        };
+        // Chunked rows: what cells() reads.
+        struct Ctx {
+            const V *a, *b, *c, *e;  // the row in the two reduced planes (min, then max)
+            const VoxelLut<T>* vl;
+        } ctx{nullptr, nullptr, nullptr, nullptr, &vl};
+        auto map_cells = [](const void* c, int i0, int i1, uint16_t* lo, uint16_t* hi) {
+            const Ctx& x = *static_cast<const Ctx*>(c);
+            for (int i = i0; i < i1; ++i) {
+                if constexpr (VoxelLut<T>::kTable) {
+                    lo[i - i0] = x.vl->lower(std::min(x.a[i], x.b[i]));
+                    hi[i - i0] = x.vl->upper(std::max(x.c[i], x.e[i]));
+                } else {
+                    lo[i - i0] = std::min(x.a[i], x.b[i]);
+                    hi[i - i0] = std::max(x.c[i], x.e[i]);
+                }
             }
         };
         for (size_t sl = s0; sl < s1; ++sl) {
@@ -176,6 +231,28 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
                     const V* b = plo[nxt].data() + size_t(j) * cx;
                     const V* c = phi[cur].data() + size_t(j) * cx;
                     const V* e = phi[nxt].data() + size_t(j) * cx;
+                    if (chunk > 0) {
+                        const size_t r = size_t(j) * nchunks;
+                        const V* ql0 = pqlo[cur].data() + r;
+                        const V* ql1 = pqlo[nxt].data() + r;
+                        const V* qh0 = pqhi[cur].data() + r;
+                        const V* qh1 = pqhi[nxt].data() + r;
+                        for (int q = 0; q < nchunks; ++q) {
+                            const V l = std::min(ql0[q], ql1[q]), h = std::max(qh0[q], qh1[q]);
+                            if constexpr (kRaw) {
+                                qlo[size_t(q)] = vl.lower(l);
+                                qhi[size_t(q)] = vl.upper(h);
+                            } else {
+                                qlo[size_t(q)] = l;
+                                qhi[size_t(q)] = h;
+                            }
+                        }
+                        ctx.a = a, ctx.b = b, ctx.c = c, ctx.e = e;
+                        if constexpr (std::is_invocable_v<Fn, const CellChunkRow&>)
+                            fn(CellChunkRow{j, k, cx, chunk, qlo.data(), qhi.data(), +map_cells,
+                                            &ctx});
+                        continue;
+                    }
                     if constexpr (kRaw) {
                         for (int i = 0; i < cx; ++i) {
                             clo[size_t(i)] = vl.lower(std::min(a[i], b[i]));
@@ -187,7 +264,8 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
                             chi[size_t(i)] = std::max(c[i], e[i]);
                         }
                     }
-                    fn(CellRow{j, k, cx, clo.data(), chi.data()});
+                    if constexpr (std::is_invocable_v<Fn, const CellRow&>)
+                        fn(CellRow{j, k, cx, clo.data(), chi.data()});
                 }
             }
         }
@@ -198,7 +276,13 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int th
 
 void for_each_cell_row(const Volume& v, ValueToLut map, int slab, int threads,
                        const std::function<void(const CellRow&)>& fn) {
-    visit_voxels(v, [&](const auto* data) { rows_typed(v, data, map, slab, threads, fn); });
+    visit_voxels(v, [&](const auto* data) { rows_typed(v, data, map, slab, 0, threads, fn); });
+}
+
+void for_each_cell_chunk_row(const Volume& v, ValueToLut map, int chunk, int threads,
+                             const std::function<void(const CellChunkRow&)>& fn) {
+    visit_voxels(v,
+                 [&](const auto* data) { rows_typed(v, data, map, chunk, chunk, threads, fn); });
 }
 
 void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,

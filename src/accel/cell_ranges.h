@@ -45,6 +45,25 @@ struct CellRow {
 void for_each_cell_row(const Volume& v, ValueToLut map, int slab, int threads,
                        const std::function<void(const CellRow&)>& fn);
 
+// One row of cells in chunks of `chunk` cells (an octree's leaves): per chunk the union of its
+// cells' LUT-entry ranges, and each cell's own range only on demand. Integer voxels reduce raw
+// values and map just each chunk's extremes (monotone map: same answer as mapping every cell),
+// so sparse data costs two table lookups per chunk instead of two per cell.
+struct CellChunkRow {
+    int j, k, n, chunk;
+    const uint16_t* chunk_lo;  // (n + chunk - 1) / chunk entries
+    const uint16_t* chunk_hi;
+    // Ranges of cells [i0, i1) (at most `chunk` of them) into lo[0 .. i1 - i0), hi[...].
+    void cells(int i0, int i1, uint16_t* lo, uint16_t* hi) const { map(ctx, i0, i1, lo, hi); }
+    void (*map)(const void* ctx, int i0, int i1, uint16_t* lo, uint16_t* hi);
+    const void* ctx;
+};
+
+// for_each_cell_row with chunked rows: slabs of `chunk` cell layers, rows in (k, j) order per
+// slab and thread. The fast path for octree builds.
+void for_each_cell_chunk_row(const Volume& v, ValueToLut map, int chunk, int threads,
+                             const std::function<void(const CellChunkRow&)>& fn);
+
 // Cells per axis (dims - 1) and blocks per axis for a block edge.
 inline void cell_counts(const Volume& v, int cells[3]) {
     const Vec3i d = v.dims();

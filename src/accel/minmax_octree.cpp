@@ -14,17 +14,10 @@ void MinMaxOctree::build() {
     m_nodes.assign(m_pyr.node_count(), Node{0xffff, 0});
     // Leaves: union of their cells' ranges, accumulated row by row.
     const int B = 1 << m_pyr.leaf_log2;
-    for_each_cell_row(m_volume, m_map, B, m_opts.threads, [&](const CellRow& r) {
+    for_each_cell_chunk_row(m_volume, m_map, B, m_opts.threads, [&](const CellChunkRow& r) {
         Node* leaf = &m_nodes[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2)];
-        for (int i0 = 0; i0 < r.n; i0 += B, ++leaf) {
-            const int i1 = std::min(r.n, i0 + B);
-            uint16_t lo = leaf->lo, hi = leaf->hi;
-            for (int i = i0; i < i1; ++i) {
-                lo = std::min(lo, r.lo[i]);
-                hi = std::max(hi, r.hi[i]);
-            }
-            *leaf = {lo, hi};
-        }
+        for (int q = 0; q * B < r.n; ++q, ++leaf)
+            *leaf = {std::min(leaf->lo, r.chunk_lo[q]), std::max(leaf->hi, r.chunk_hi[q])};
     });
     // Inner nodes: union of their children.
     for (int l = 1; l < m_pyr.levels; ++l)

@@ -197,6 +197,56 @@ TEST(CellRanges, CellRowsCoverEveryRowOnceAndEachSlabComesFromOneThreadInOrder) 
     }
 }
 
+// for_each_cell_chunk_row: per chunk the union of the per-cell ranges of for_each_cell_row, and
+// cells() each cell's own range, for every voxel type, odd sizes and chunk edges, the last
+// chunk of a row partial; every row once, each slab from one thread in order.
+TEST(CellRanges, ChunkRowsGiveTheUnionOfTheirCellsAndEachCellOnDemand) {
+    Rng rng{61};
+    for (int trial = 0; trial < 48; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 23), rng);
+        const int chunk = trial % 3 == 0 ? 1 << rng.range(0, 5) : rng.range(1, 11);
+        const int threads = rng.range(0, 3);
+        const ValueToLut map(v.vis_range(), kLutSizes[rng.range(0, 7)]);
+        const BuiltRanges ref = built_ranges(v, map, -chunk, 1);
+        const CellGrid& g = ref.g;
+        const std::string what = to_string(v) + " chunk " + std::to_string(chunk);
+        std::mutex mu;
+        std::vector<int> hits(size_t(g.n[1]) * g.n[2], 0);
+        std::vector<std::string> errors;
+        for_each_cell_chunk_row(v, map, chunk, threads, [&](const CellChunkRow& r) {
+            std::vector<std::string> err;
+            if (r.n != g.n[0] || r.chunk != chunk) err.push_back("row shape");
+            uint16_t lo[64], hi[64];
+            for (int q = 0, i0 = 0; i0 < r.n; ++q, i0 += chunk) {
+                const int i1 = std::min(r.n, i0 + chunk);
+                int ulo = 1 << 30, uhi = -1;
+                for (int i = i0; i < i1; ++i) {
+                    const size_t id = g.index(i, r.j, r.k);
+                    ulo = std::min(ulo, ref.lo[id]), uhi = std::max(uhi, ref.hi[id]);
+                }
+                if (r.chunk_lo[q] != ulo || r.chunk_hi[q] != uhi)
+                    err.push_back("chunk " + std::to_string(q) + " of row " + std::to_string(r.j) +
+                                  "," + std::to_string(r.k) + ": union " +
+                                  std::to_string(r.chunk_lo[q]) + ".." +
+                                  std::to_string(r.chunk_hi[q]) + " expected " +
+                                  std::to_string(ulo) + ".." + std::to_string(uhi));
+                r.cells(i0, i1, lo, hi);
+                for (int i = i0; i < i1; ++i) {
+                    const size_t id = g.index(i, r.j, r.k);
+                    if (lo[i - i0] != ref.lo[id] || hi[i - i0] != ref.hi[id])
+                        err.push_back("cell " + std::to_string(i) + "," + std::to_string(r.j) +
+                                      "," + std::to_string(r.k));
+                }
+            }
+            std::lock_guard<std::mutex> lock(mu);
+            ++hits[size_t(r.k) * g.n[1] + r.j];
+            errors.insert(errors.end(), err.begin(), err.end());
+        });
+        for (const std::string& e : errors) ADD_FAILURE() << what << ": " << e;
+        for (size_t h = 0; h < hits.size(); ++h) ASSERT_EQ(hits[h], 1) << what << " row " << h;
+    }
+}
+
 // ---- The invariant exact skipping rests on -------------------------------------------------
 
 // A coordinate along one axis of a grid with `cells` cells, biased towards the awkward places:
