@@ -27,6 +27,8 @@ enum class AccelKind {
     Distance,   // Euclidean distance map at 1/4 resolution, rebuilt when the TF changes
     Chebyshev,  // Chebyshev distance map at 1/4 resolution, rebuilt when the TF changes
     KdTree,     // kd-tree empty-space partition (kd-tree paper), rebuilt when the TF changes
+    MinMaxInterval,  // the min-max octree as the bitfield paper tests it: empty when [min, max]
+                     // misses the TF's one interval [first visible entry, last visible entry]
 };
 
 std::string to_string(AccelKind k);

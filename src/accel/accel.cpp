@@ -13,7 +13,8 @@ struct Entry {
 constexpr Entry kAccels[] = {{AccelKind::None, "none"},         {AccelKind::Distance, "distance"},
                              {AccelKind::Chebyshev, "chebyshev"}, {AccelKind::Boolean, "boolean"},
                              {AccelKind::MinMax, "minmax"},     {AccelKind::Bitfield, "bitfield"},
-                             {AccelKind::KdTree, "kdtree"}};
+                             {AccelKind::KdTree, "kdtree"},
+                             {AccelKind::MinMaxInterval, "minmax-interval"}};
 }  // namespace
 
 std::string to_string(AccelKind k) {
@@ -45,7 +46,8 @@ AccelKind parse_accel(const std::string& name) {
 std::unique_ptr<Accel> make_accel(AccelKind k, const Volume& volume, const AccelOptions& opts) {
     switch (k) {
         case AccelKind::None: return std::make_unique<NoAccel>();
-        case AccelKind::MinMax: return std::make_unique<MinMaxOctree>(volume, opts);
+        case AccelKind::MinMax:
+        case AccelKind::MinMaxInterval: return std::make_unique<MinMaxOctree>(k, volume, opts);
         case AccelKind::Bitfield: return std::make_unique<BitfieldOctree>(volume, opts);
         case AccelKind::Boolean: return std::make_unique<BooleanOctree>(volume, opts);
         case AccelKind::Distance:

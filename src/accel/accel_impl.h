@@ -14,7 +14,8 @@ namespace lacuna {
 template <class F>
 decltype(auto) visit_accel(const Accel& a, F&& f) {
     switch (a.kind()) {
-        case AccelKind::MinMax: return f(static_cast<const MinMaxOctree&>(a));
+        case AccelKind::MinMax:
+        case AccelKind::MinMaxInterval: return f(static_cast<const MinMaxOctree&>(a));
         case AccelKind::Bitfield: return f(static_cast<const BitfieldOctree&>(a));
         case AccelKind::Boolean: return f(static_cast<const BooleanOctree&>(a));
         case AccelKind::Distance:

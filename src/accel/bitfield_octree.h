@@ -54,6 +54,10 @@ public:
         });
     }
     int bits() const { return m_nbits; }
+    // Node i's bitfield (words() uint64, bit b in word b/64) and the bin of a LUT entry (tests).
+    const uint64_t* node_bits(size_t i) const { return &m_bits[i * size_t(m_words)]; }
+    int words() const { return m_words; }
+    int bin_of(int entry) const { return bin(entry); }
     // The TF bitfield (tests, the viewer's overlay).
     const uint64_t* tf_bits() const { return m_tf; }
 

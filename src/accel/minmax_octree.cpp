@@ -4,8 +4,8 @@
 
 namespace lacuna {
 
-MinMaxOctree::MinMaxOctree(const Volume& v, const AccelOptions& o)
-    : OctreeBase(AccelKind::MinMax, v, o) {
+MinMaxOctree::MinMaxOctree(AccelKind k, const Volume& v, const AccelOptions& o)
+    : OctreeBase(k, v, o), m_interval(k == AccelKind::MinMaxInterval) {
     build();
 }
 
@@ -41,6 +41,12 @@ void MinMaxOctree::set_transfer_function(const TransferLut& lut) {
     const auto t0 = std::chrono::steady_clock::now();
     if (needs_rebuild(lut)) build();
     m_prefix.build(lut);
+    m_first = 1 << 30, m_last = -1;
+    for (int e = 0; e < lut.size(); ++e)
+        if (lut.entries[size_t(e)].a > 0.f) {
+            if (m_first > m_last) m_first = e;
+            m_last = e;
+        }
     m_stats.tf_update_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -29,7 +29,8 @@ TEST(AccelFactory, MakesEveryKindWithItsOwnType) {
         const std::type_info& dynamic = typeid(base);
         // The structures this file knows; a newer kind only has to agree with visit_accel.
         const std::type_info* expected = k == AccelKind::None       ? &typeid(NoAccel)
-                                         : k == AccelKind::MinMax   ? &typeid(MinMaxOctree)
+                                         : k == AccelKind::MinMax || k == AccelKind::MinMaxInterval
+                                             ? &typeid(MinMaxOctree)
                                          : k == AccelKind::Bitfield ? &typeid(BitfieldOctree)
                                          : k == AccelKind::Boolean  ? &typeid(BooleanOctree)
                                          : k == AccelKind::Distance || k == AccelKind::Chebyshev

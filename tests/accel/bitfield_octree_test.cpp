@@ -2,6 +2,7 @@
 // extreme corners, the TF bitfield, the 128-bit layout, and TF changes that must not touch the
 // TF-independent tree unless the value mapping changes.
 #include "accel/bitfield_octree.h"
+#include "accel/minmax_octree.h"
 
 #include <gtest/gtest.h>
 
@@ -264,6 +265,52 @@ TEST(BitfieldOctree, VisRangeOrLutSizeChangeRebuildsTheTreeExactly) {
                     }
         }
     }
+}
+
+// Why bitfield cannot skip more than the prefix-count min-max octree (docs/benchmarks.md,
+// "Bitfield vs minmax on gaps"): a node is a box of cells, neighbouring cells share corner
+// voxels, so their ranges overlap and the union over any box is one interval [lo, hi]. The
+// node's bitfield is therefore exactly the run of bins bin(lo)..bin(hi) of the min-max node's
+// range, and whenever bitfield finds a node empty the prefix count does too. Checked for every
+// node of trees over random volumes of every type, leaf sizes and widths.
+TEST(BitfieldOctree, NodeBitsAreTheBinRunOfTheMinMaxRangeSoMinMaxSkipsAtLeastAsMuch) {
+    Rng rng{83};
+    int nodes = 0, bitfield_empty = 0;
+    for (int trial = 0; trial < 24; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 30), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 3);
+        o.bitfield_bits = 8 << rng.range(0, 4);
+        o.threads = rng.range(0, 2);
+        BitfieldOctree bf(v, o);
+        MinMaxOctree mm(AccelKind::MinMax, v, o);
+        const std::string what = to_string(v) + " leaf " + std::to_string(o.leaf_cells) +
+                                 " bits " + std::to_string(o.bitfield_bits);
+        for (size_t i = 0; i < mm.pyramid().node_count(); ++i, ++nodes) {
+            const MinMaxOctree::Node nd = mm.node(i);
+            uint64_t want[2] = {0, 0};
+            if (nd.lo <= nd.hi)
+                for (int b = bf.bin_of(nd.lo); b <= bf.bin_of(nd.hi); ++b)
+                    want[b >> 6] |= uint64_t(1) << (b & 63);
+            for (int w = 0; w < bf.words(); ++w)
+                ASSERT_EQ(bf.node_bits(i)[w], want[w]) << what << " node " << i << " word " << w;
+        }
+        for (int tf = 0; tf < 6; ++tf) {
+            const TransferLut lut = random_lut(v.vis_range(), kDefaultLutSize, rng);
+            bf.set_transfer_function(lut);
+            mm.set_transfer_function(lut);
+            for (size_t i = 0; i < mm.pyramid().node_count(); ++i) {
+                if (!bf.empty_node(i)) continue;
+                ++bitfield_empty;
+                const MinMaxOctree::Node nd = mm.node(i);
+                for (int e = nd.lo; e <= nd.hi; ++e)
+                    ASSERT_EQ(lut.entries[size_t(e)].a, 0.f)
+                        << what << " node " << i << ": bitfield empty, entry " << e << " visible";
+            }
+        }
+    }
+    EXPECT_GT(nodes, 1000);
+    EXPECT_GT(bitfield_empty, 100);
 }
 
 }  // namespace

@@ -147,10 +147,13 @@ TEST(Pyramid, RejectsLeafSizesThatAreNotPowersOfTwoIn2To64) {
 
 // ---- Octree regions against brute force -----------------------------------------------------
 
-enum class Tree { MinMax, Bitfield, Boolean };
+enum class Tree { MinMax, Bitfield, Boolean, MinMaxInterval };
 
 std::string tree_name(Tree t) {
-    return t == Tree::MinMax ? "minmax" : (t == Tree::Bitfield ? "bitfield" : "boolean");
+    return t == Tree::MinMax     ? "minmax"
+           : t == Tree::Bitfield ? "bitfield"
+           : t == Tree::Boolean  ? "boolean"
+                                 : "minmax-interval";
 }
 
 // An independent pyramid with every node's emptiness computed straight from its cells' built
@@ -197,6 +200,16 @@ struct OctreeOracle {
                                 }
                         bool is_empty = true;
                         if (t == Tree::MinMax) is_empty = !scan_visible(lut, lo, hi);
+                        if (t == Tree::MinMaxInterval) {
+                            // The paper's test: [lo, hi] misses [first, last visible entry].
+                            int first = -1, last = -1;
+                            for (int e2 = 0; e2 < size; ++e2)
+                                if (lut.entries[size_t(e2)].a > 0.f) {
+                                    if (first < 0) first = e2;
+                                    last = e2;
+                                }
+                            is_empty = first < 0 || hi < first || lo > last;
+                        }
                         if (t == Tree::Boolean) is_empty = !any_visible_cell;
                         if (t == Tree::Bitfield)
                             for (int q = 0; q < bits; ++q)
@@ -234,7 +247,9 @@ struct OctreeOracle {
 std::unique_ptr<OctreeBase> make_tree(Tree t, const Volume& v, const AccelOptions& o) {
     switch (t) {
         case Tree::MinMax:
-            return std::make_unique<MinMaxOctree>(v, o);
+        case Tree::MinMaxInterval:
+            return std::make_unique<MinMaxOctree>(
+                t == Tree::MinMax ? AccelKind::MinMax : AccelKind::MinMaxInterval, v, o);
         case Tree::Bitfield:
             return std::make_unique<BitfieldOctree>(v, o);
         case Tree::Boolean:
@@ -246,6 +261,7 @@ std::unique_ptr<OctreeBase> make_tree(Tree t, const Volume& v, const AccelOption
 Region tree_region(Tree t, const OctreeBase& tree, const int cell[3], int& hint) {
     switch (t) {
         case Tree::MinMax:
+        case Tree::MinMaxInterval:
             return static_cast<const MinMaxOctree&>(tree).region(cell, hint);
         case Tree::Bitfield:
             return static_cast<const BitfieldOctree&>(tree).region(cell, hint);
@@ -339,6 +355,9 @@ TEST(BitfieldOctree, RegionIsTheCoarsestEmptyNodeByBruteForce) {
 TEST(BooleanOctree, RegionIsTheCoarsestEmptyNodeByBruteForce) {
     expect_regions_match_brute_force(Tree::Boolean, 33, 40);
 }
+TEST(MinMaxOctree, IntervalTestRegionIsTheCoarsestEmptyNodeByBruteForce) {
+    expect_regions_match_brute_force(Tree::MinMaxInterval, 34, 40);
+}
 
 // The header's claim: emptiness is monotone, so bidirectional search (starting at the previous
 // answer's level) and top-down search (from the initial level every time) give the same region.
@@ -381,7 +400,7 @@ TEST(MinMaxOctree, LeafWithAVisibleCellIsAlwaysOccupied) {
         const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 18), rng);
         AccelOptions o = random_octree_options(rng);
         o.leaf_cells = 2;
-        MinMaxOctree tree(v, o);
+        MinMaxOctree tree(AccelKind::MinMax, v, o);
         const ValueToLut map(v.vis_range(), kDefaultLutSize);
         const TransferLut lut =
             random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, map, rng));
