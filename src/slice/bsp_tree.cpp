@@ -200,6 +200,26 @@ size_t BspTree::sub_volumes() const {
     return n;
 }
 
+void BspTree::order_cut(Vec3f key, bool is_dir, const std::vector<uint8_t>& cut,
+                        std::vector<int32_t>& out) const {
+    out.clear();
+    if (m_nodes.empty()) return;
+    std::vector<int32_t> stack{0};
+    while (!stack.empty()) {
+        const int32_t i = stack.back();
+        stack.pop_back();
+        const BspNode& n = m_nodes[size_t(i)];
+        if (cut[size_t(i)] == kSkip) continue;
+        if (cut[size_t(i)] == kEmit || n.is_leaf()) {
+            out.push_back(i);
+            continue;
+        }
+        const bool low_first = is_dir ? key[n.axis] >= 0.f : key[n.axis] < float(n.plane);
+        stack.push_back(low_first ? n.low + 1 : n.low);
+        stack.push_back(low_first ? n.low : n.low + 1);
+    }
+}
+
 void BspTree::traverse(Vec3f key, bool is_dir, std::vector<int32_t>& out) const {
     out.clear();
     if (m_nodes.empty()) return;

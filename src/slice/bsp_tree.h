@@ -81,6 +81,12 @@ class BspTree {
     // Leaf box indices front to back for an eye (index space), or for parallel rays along dir.
     void order(Vec3f eye, std::vector<int32_t>& out) const { traverse(eye, false, out); }
     void order_along(Vec3f dir, std::vector<int32_t>& out) const { traverse(dir, true, out); }
+    // Node indices front to back through a cut of the tree: cut[node] = 0 descends (inner nodes
+    // only), 1 emits the node (its room), 2 skips its subtree. For an eye (is_dir false) or
+    // parallel rays along a direction (is_dir true).
+    enum Cut : uint8_t { kDescend = 0, kEmit = 1, kSkip = 2 };
+    void order_cut(Vec3f key, bool is_dir, const std::vector<uint8_t>& cut,
+                   std::vector<int32_t>& out) const;
 
     const std::vector<BspNode>& nodes() const { return m_nodes; }
     const std::vector<BspBox>& boxes() const { return m_boxes; }

@@ -56,6 +56,11 @@ struct BoxesOptions {
     float other_cost = 512.f;     // other box: volume x spread / full scale <= this (cells)
     int thin = 2;                 // merge rule 3: a box with an extent < thin cells is thin
     bool merge = true;            // bottom-up merging of the BSP tree (Section 3.2)
+    // Per TF (lacuna's addition, docs/growing-boxes.md): a BSP subtree whose room is at most this
+    // fraction empty cells is rendered as one box (its room) instead of leaf by leaf; fewer,
+    // larger boxes amortise the per-box polygon set-up. Exact for any value (the image is the
+    // Basic image); 0 joins only subtrees without an empty leaf; negative: off.
+    float coalesce = 0.25f;
     int threads = 0;              // 0 = all
 };
 // Throws lacuna::Error naming the CLI option ("--spread", ...) for a bad value.

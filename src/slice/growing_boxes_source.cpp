@@ -99,6 +99,38 @@ GrowingBoxesSource::GrowingBoxesSource(const Volume& v, const BoxesOptions& o)
     m_stats.ranges = m_classifier.seconds();
     m_stats.intervals = m_classifier.intervals();
     m_empty.assign(m_leaves.size(), 0);  // everything may be visible until a TF is set
+    make_cut();
+}
+
+// Bottom-up over the tree: the non-empty cells of every subtree; a subtree with none is skipped,
+// one whose room is at most `coalesce` empty is emitted whole, others descend. Children have
+// larger indices than their parent (the tree is built top-down), so a reverse sweep is
+// bottom-up.
+void GrowingBoxesSource::make_cut() {
+    const std::vector<BspNode>& nodes = m_tree.nodes();
+    std::vector<double> full(nodes.size(), 0.0);
+    m_cut.assign(nodes.size(), BspTree::kDescend);
+    for (size_t i = nodes.size(); i-- > 0;) {
+        const BspNode& n = nodes[i];
+        if (n.is_leaf()) {
+            const int32_t slot = n.box >= 0 ? m_slot[size_t(n.box)] : -1;
+            const bool visible = slot >= 0 && !m_empty[size_t(slot)];
+            full[i] = visible ? double(box_volume(n.room)) : 0.0;
+            m_cut[i] = visible ? BspTree::kEmit : BspTree::kSkip;
+            continue;
+        }
+        full[i] = full[size_t(n.low)] + full[size_t(n.low) + 1];
+        if (full[i] == 0.0)
+            m_cut[i] = BspTree::kSkip;
+        else if (m_opts.coalesce >= 0.f &&
+                 full[i] >= (1.0 - double(m_opts.coalesce)) * double(box_volume(n.room)))
+            m_cut[i] = BspTree::kEmit;
+    }
+    // Count what a traversal emits (any view emits the same set).
+    std::vector<int32_t> order;
+    m_tree.order_cut(Vec3f{1, 1, 1}, true, m_cut, order);
+    m_emitted = order.size();
+    m_stats.emitted = m_emitted;
 }
 
 void GrowingBoxesSource::set_transfer_function(const TransferLut& lut) {
@@ -113,27 +145,27 @@ void GrowingBoxesSource::set_transfer_function(const TransferLut& lut) {
     m_classifier.classify(lut, m_empty);
     m_stats.empty = 0;
     for (uint8_t e : m_empty) m_stats.empty += e;
+    make_cut();
     m_stats.classify = since(t0);
 }
 
-std::vector<CellBox> GrowingBoxesSource::emit(const std::vector<int32_t>& order) const {
+std::vector<CellBox> GrowingBoxesSource::emit(const std::vector<int32_t>& nodes) const {
     std::vector<CellBox> out;
-    out.reserve(order.size());
-    for (int32_t b : order)
-        if (!m_empty[size_t(m_slot[size_t(b)])]) out.push_back(m_tree.boxes()[size_t(b)].box);
+    out.reserve(nodes.size());
+    for (int32_t n : nodes) out.push_back(m_tree.nodes()[size_t(n)].room);
     return out;
 }
 
 std::vector<CellBox> GrowingBoxesSource::boxes_front_to_back(Vec3f eye) const {
-    std::vector<int32_t> order;
-    m_tree.order(eye, order);
-    return emit(order);
+    std::vector<int32_t> nodes;
+    m_tree.order_cut(eye, false, m_cut, nodes);
+    return emit(nodes);
 }
 
 std::vector<CellBox> GrowingBoxesSource::boxes_front_to_back_along(Vec3f dir) const {
-    std::vector<int32_t> order;
-    m_tree.order_along(dir, order);
-    return emit(order);
+    std::vector<int32_t> nodes;
+    m_tree.order_cut(dir, true, m_cut, nodes);
+    return emit(nodes);
 }
 
 size_t GrowingBoxesSource::bytes() const {

@@ -22,6 +22,7 @@ struct BoxesBuildStats {
     size_t grown = 0, grown_by_type[3] = {0, 0, 0};  // indexed by BoxType
     size_t after_split = 0, after_merge = 0, final_by_type[3] = {0, 0, 0};
     size_t empty = 0;        // final leaves empty under the current TF
+    size_t emitted = 0;      // boxes rendered under the current TF (after coalescing)
     size_t sub_volumes = 0;  // parentless leaves + live parents (the paper's textures)
     size_t intervals = 0;    // LUT-entry intervals kept by the classifier
     int depth = 0;
@@ -47,8 +48,13 @@ class GrowingBoxesSource final : public BoxSource {
     const BoxesBuildStats& stats() const { return m_stats; }
     size_t bytes() const;
 
+    // The current TF's cut of the tree (BspTree::Cut per node) and the boxes it emits.
+    const std::vector<uint8_t>& cut() const { return m_cut; }
+    size_t emitted() const { return m_emitted; }
+
   private:
-    std::vector<CellBox> emit(const std::vector<int32_t>& order) const;
+    void make_cut();
+    std::vector<CellBox> emit(const std::vector<int32_t>& nodes) const;
     const Volume& m_volume;
     BoxesOptions m_opts;
     std::vector<BoxInfo> m_grown;
@@ -58,6 +64,8 @@ class GrowingBoxesSource final : public BoxSource {
     std::vector<int32_t> m_slot;  // box index -> position in m_leaves (-1: not a final leaf)
     BoxClassifier m_classifier;
     std::vector<uint8_t> m_empty;  // per final leaf (m_leaves order)
+    std::vector<uint8_t> m_cut;    // per tree node: BspTree::Cut under the current TF
+    size_t m_emitted = 0;          // boxes the cut emits
     BoxesBuildStats m_stats;
 };
 

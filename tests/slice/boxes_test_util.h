@@ -59,6 +59,8 @@ inline BoxesOptions random_options(Rng& rng) {
     o.other_cost = float(rng.range(0, 200));
     o.thin = rng.range(0, 4);
     o.merge = !rng.coin(4);
+    const float coalesce[] = {-1.f, 0.f, 0.1f, 0.25f, 0.5f, 1.f};
+    o.coalesce = coalesce[rng.range(0, 5)];
     o.threads = rng.range(1, 2);
     return o;
 }

@@ -248,7 +248,9 @@ TEST(BoxClassifier, EverySingleEntrySpikeOnAThinSheet) {
         for (int j = 0; j < 11; ++j) v.set_value(7, j, k, 200);
     v.compute_range();
     v.set_vis_range(ValueRange{0, 255});
-    GrowingBoxesSource src(v, BoxesOptions{});
+    BoxesOptions o;
+    o.coalesce = -1.f;  // every non-empty leaf on its own
+    GrowingBoxesSource src(v, o);
     const ValueToLut map(v.vis_range(), 64);
     const accel_test::BuiltRanges built = accel_test::built_ranges(v, map, -8);
     for (int e = 0; e < 64; ++e) {
@@ -303,6 +305,48 @@ TEST(GrowingBoxesSource, ReturnsDisjointNonEmptyBoxesInVisibilityOrderCoveringVi
                     }
             expect_visibility_order(boxes, key, is_dir, what);
         }
+    }
+}
+
+// Coalescing (BoxesOptions::coalesce): every emitted box is a BSP room that holds every visible
+// leaf inside it (each in exactly one box), at most `coalesce` of its cells in empty leaves
+// (0: none); off (< 0) emits exactly the non-empty leaves; 1 emits one box.
+TEST(GrowingBoxesSource, CoalescedBoxesAreRoomsWithinTheEmptyShare) {
+    Rng rng{43};
+    for (int iter = 0; iter < 30; ++iter) {
+        const Volume v = adversarial_volume(iter % 6, accel_test::kAllTypes[iter % 4], rng);
+        BoxesOptions o = random_options(rng);
+        const float shares[] = {-1.f, 0.f, 0.2f, 0.6f, 1.f};
+        o.coalesce = shares[iter % 5];
+        GrowingBoxesSource src(v, o);
+        src.set_transfer_function(accel_test::random_lut(v.vis_range(), kDefaultLutSize, rng));
+        const std::string what = "iter " + std::to_string(iter) + " coalesce " +
+                                 std::to_string(o.coalesce) + " " + to_string(v);
+        // Non-empty leaf cells per emitted box, by brute force over the leaves.
+        size_t nonempty_leaves = 0;
+        const std::vector<CellBox> boxes = src.boxes_front_to_back_along(Vec3f{1, -1, 1});
+        std::vector<double> full(boxes.size(), 0.0);
+        for (int32_t id : src.leaves()) {
+            if (src.empty(id)) continue;
+            ++nonempty_leaves;
+            const CellBox& lb = src.tree().boxes()[size_t(id)].box;
+            size_t owners = 0;
+            for (size_t b = 0; b < boxes.size(); ++b)
+                if (inside(lb, boxes[b])) ++owners, full[b] += double(box_volume(lb));
+            ASSERT_EQ(owners, 1u) << what << ": a visible leaf in " << owners << " boxes";
+        }
+        ASSERT_EQ(src.emitted(), boxes.size()) << what;
+        for (size_t b = 0; b < boxes.size(); ++b) {
+            const double vol = double(box_volume(boxes[b]));
+            ASSERT_GT(full[b], 0.0) << what << ": an emitted box without a visible leaf";
+            if (o.coalesce >= 0.f)
+                ASSERT_GE(full[b], (1.0 - double(o.coalesce)) * vol - 1e-9)
+                    << what << ": box " << to_string(boxes[b]) << " too empty";
+            else
+                ASSERT_EQ(full[b], vol) << what;
+        }
+        if (o.coalesce < 0.f) ASSERT_EQ(boxes.size(), nonempty_leaves) << what;
+        if (o.coalesce >= 1.f && nonempty_leaves > 0) ASSERT_EQ(boxes.size(), 1u) << what;
     }
 }
 
