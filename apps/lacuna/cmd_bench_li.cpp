@@ -17,12 +17,14 @@ namespace lacuna::cli {
 namespace {
 
 struct LiArgs {
-    int size = 192, views = 8;
+    int size = 384, views = 8;
     float elevation = 20.f;
-    std::string datasets = "ch2-skin,ch2bet-brain";
+    std::string datasets = "ch2-skin,ch2bet-brain,ch2better-brain,aal,tree512";
     std::string ess = "boxes";
     float step = 0.5f, threshold = 0.95f;
     int map = 64, updates = 9, threads = 0;
+    float coalesce = BoxesOptions{}.coalesce;
+    int coalesce_edge = BoxesOptions{}.coalesce_edge;
     bool no_march = false;
     std::string out_dir = "out/bench";
     std::string templates = bench::DatasetSource{}.templates_dir;
@@ -52,6 +54,8 @@ void run_li(const LiArgs& a) {
     if (a.ess != "kdtree" && a.ess != "boxes")
         throw Error("--ess", "box source", "expected kdtree or boxes, got '" + a.ess + "'");
     o.ess = a.ess;
+    o.boxes.coalesce = a.coalesce;
+    o.boxes.coalesce_edge = a.coalesce_edge;
     o.step = a.step;
     o.threshold = a.threshold;
     o.map_size = a.map;
@@ -106,6 +110,12 @@ void register_bench_li(CLI::App& bench) {
     c->add_option("--datasets", a->datasets, "Comma-separated datasets: " + names)
         ->capture_default_str();
     c->add_option("--ess", a->ess, "Box source of the ESS columns: kdtree or boxes")
+        ->capture_default_str();
+    c->add_option("--coalesce", a->coalesce,
+                  "ESS boxes: a BSP subtree at most this share empty is one box (negative: off)")
+        ->capture_default_str();
+    c->add_option("--coalesce-edge", a->coalesce_edge,
+                  "ESS boxes: largest joined box, cells per axis")
         ->capture_default_str();
     c->add_option("--step", a->step, "Slice distance in voxels")->capture_default_str();
     c->add_option("--threshold", a->threshold, "Occlusion opacity threshold")->capture_default_str();

@@ -310,6 +310,7 @@ void register_render(CLI::App& app) {
     cmd->callback([a, cmd] {
         a->slice.threshold_given = cmd->count("--occlusion-threshold") > 0;
         a->slice.map_given = cmd->count("--occlusion-map") > 0;
+        a->slice.coalesce_given = cmd->count("--coalesce") > 0;
         a->azimuth_given = cmd->count("--azimuth") > 0;
         a->elevation_given = cmd->count("--elevation") > 0;
         run(*a);

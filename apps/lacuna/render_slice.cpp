@@ -21,6 +21,13 @@ void add_slice_options(CLI::App& cmd, SliceCliArgs& a) {
         ->capture_default_str();
     cmd.add_option("--occlusion-map", a.occlusion_map, "Slicer: opacity map edge in cells")
         ->capture_default_str();
+    cmd.add_option("--coalesce", a.coalesce,
+                   "Slicer, --accel boxes: render a BSP subtree as one box when at most this "
+                   "share of it is empty (exact for any value; negative: every leaf alone)")
+        ->capture_default_str();
+    cmd.add_option("--coalesce-edge", a.coalesce_edge,
+                   "Slicer, --accel boxes: largest box --coalesce makes, cells per axis")
+        ->capture_default_str();
 }
 
 void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap) {
@@ -30,6 +37,8 @@ void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap) {
         if (a.occlusion || a.threshold_given || a.map_given)
             throw Error("--occlusion", "renderer",
                         "occlusion clipping belongs to the slicer: add --renderer slice");
+        if (a.coalesce_given || a.coalesce_edge != BoxesOptions{}.coalesce_edge)
+            throw Error("--coalesce", "renderer", "belongs to the slicer: add --renderer slice");
         return;
     }
     if (animate) throw Error("--tf-animate", "renderer", "only with --renderer march");
@@ -47,7 +56,10 @@ void render_slice(const SliceCliArgs& a, const SliceRenderJob& job) {
     const Volume vol = load_volume(job.volume);
     const TransferLut lut = discretise(tf, vol.vis_range());
     Progress progress("building " + job.accel);
-    auto source = make_box_source(job.accel, vol, job.accel_options);
+    BoxesOptions boxes;
+    boxes.coalesce = a.coalesce;
+    boxes.coalesce_edge = a.coalesce_edge;
+    auto source = make_box_source(job.accel, vol, job.accel_options, boxes);
     source->set_transfer_function(lut);
     progress.done();
     SliceRenderer slicer(vol);

@@ -5,6 +5,7 @@
 
 #include "cli_common.h"
 #include "lacuna/renderer.h"
+#include "slice/growing_boxes.h"
 
 namespace lacuna::cli {
 
@@ -13,7 +14,9 @@ struct SliceCliArgs {
     bool occlusion = false;
     float occlusion_threshold = 0.95f;
     int occlusion_map = 64;
-    bool threshold_given = false, map_given = false;
+    float coalesce = BoxesOptions{}.coalesce;
+    int coalesce_edge = BoxesOptions{}.coalesce_edge;
+    bool threshold_given = false, map_given = false, coalesce_given = false;
 };
 void add_slice_options(CLI::App& cmd, SliceCliArgs& a);
 // Throws lacuna::Error for an unknown renderer or flags that do not fit it. `animate` and

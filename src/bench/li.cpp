@@ -61,7 +61,7 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
         SliceRenderer slicer(vol);
         slicer.set_transfer_function(ds.lut);
         const auto t0 = std::chrono::steady_clock::now();
-        auto source = make_box_source(o.ess, vol, o.accel);
+        auto source = make_box_source(o.ess, vol, o.accel, o.boxes);
         source->set_transfer_function(ds.lut);
         d.source_ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3;
         const std::vector<Camera> cams = orbit_cameras(slicer.bounds(), o.orbit);

@@ -18,13 +18,15 @@
 #include "bench/orbit.h"
 #include "bench/report.h"
 #include "lacuna/accel.h"
+#include "slice/growing_boxes.h"
 
 namespace lacuna::bench {
 
 struct LiOptions {
-    OrbitSpec orbit{8, 192, 20.f};
+    OrbitSpec orbit{8, 384, 20.f};
     std::string ess = "boxes";  // box source of the ESS columns
     AccelOptions accel;
+    BoxesOptions boxes;  // the ESS source "boxes"
     float step = 0.5f;
     float threshold = 0.95f;
     int map_size = 64;

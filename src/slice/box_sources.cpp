@@ -34,12 +34,13 @@ class KdTreeBoxSource final : public BoxSource {
 std::vector<std::string> box_source_names() { return {"none", "kdtree", "boxes"}; }
 
 std::unique_ptr<BoxSource> make_box_source(const std::string& name, const Volume& volume,
-                                           const AccelOptions& options) {
+                                           const AccelOptions& options, const BoxesOptions& boxes) {
     if (name == "none") return std::make_unique<VolumeBoxSource>(volume);
     if (name == "kdtree") return std::make_unique<KdTreeBoxSource>(volume, options);
     if (name == "boxes") {
-        BoxesOptions bo;  // the paper's settings (growing_boxes.h)
+        BoxesOptions bo = boxes;
         bo.threads = options.threads;
+        validate(bo);
         return make_growing_boxes_source(volume, bo);
     }
     throw Error("--accel", "box source",

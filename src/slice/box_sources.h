@@ -9,6 +9,7 @@
 #include "lacuna/accel.h"
 #include "lacuna/volume.h"
 #include "slice/box_source.h"
+#include "slice/growing_boxes.h"
 
 namespace lacuna {
 
@@ -25,11 +26,13 @@ class VolumeBoxSource final : public BoxSource {
     CellBox m_box;
 };
 
-// Names make_box_source accepts ("boxes" with the default BoxesOptions of growing_boxes.h).
+// Names make_box_source accepts.
 std::vector<std::string> box_source_names();
 // Builds the source `name` over `volume` (which must outlive it). Throws lacuna::Error
 // ("--accel", "box source", ...) for an unknown name or one the slicer cannot use.
+// "boxes" takes `boxes` (the paper's settings by default; its threads come from `options`).
 std::unique_ptr<BoxSource> make_box_source(const std::string& name, const Volume& volume,
-                                           const AccelOptions& options = {});
+                                           const AccelOptions& options = {},
+                                           const BoxesOptions& boxes = {});
 
 }  // namespace lacuna

@@ -292,15 +292,18 @@ void validate(const BoxesOptions& o) {
         throw bad("--other-cost", "a finite value >= 0 (cells)", o.other_cost);
     if (o.thin < 0 || o.thin > 4096) throw bad("--thin", "0..4096 cells", o.thin);
     if (o.threads < 0) throw bad("--threads", ">= 0", o.threads);
+    if (!(o.coalesce <= 1.f)) throw bad("--coalesce", "a share <= 1 (negative: off)", o.coalesce);
+    if (o.coalesce_edge < 1) throw bad("--coalesce-edge", ">= 1 cells", o.coalesce_edge);
 }
 
 std::string to_string(const BoxesOptions& o) {
-    char buf[200];
+    char buf[240];
     std::snprintf(buf, sizeof buf,
                   "spread %g/256, min box %d, gradient %g, gradient waste %g, other cost %g, "
-                  "thin %d, merge %s",
+                  "thin %d, merge %s, coalesce %g up to %d cells",
                   double(o.spread), o.min_uniform, double(o.gradient), double(o.gradient_waste),
-                  double(o.other_cost), o.thin, o.merge ? "on" : "off");
+                  double(o.other_cost), o.thin, o.merge ? "on" : "off", double(o.coalesce),
+                  o.coalesce_edge);
     return buf;
 }
 
@@ -382,8 +385,8 @@ void BoxClassifier::build(const Volume& v, ValueRange vis, int lut_size,
         std::copy_n(r.lo, r.n, &clo[at]);
         std::copy_n(r.hi, r.n, &chi[at]);
     });
-    // 2. Per box, the union of the ranges of its cells and of the cells one past its upper faces:
-    // a difference array over the LUT entries, swept into maximal runs.
+    // 2. Per box, the union of the ranges of its cells: a difference array over the LUT
+    // entries, swept into maximal runs.
     std::vector<std::vector<uint16_t>> runs(boxes.size());
     parallel_for(
         boxes.size(), threads,
@@ -394,7 +397,7 @@ void BoxClassifier::build(const Volume& v, ValueRange vis, int lut_size,
                 int lo[3], hi[3];
                 for (int a = 0; a < 3; ++a) {
                     lo[a] = b.lo[a];
-                    hi[a] = std::min(c[a], b.hi[a] + 1);
+                    hi[a] = b.hi[a];
                 }
                 int first = lut_size, last = -1;
                 for (int k = lo[2]; k < hi[2]; ++k)

@@ -61,6 +61,9 @@ struct BoxesOptions {
     // larger boxes amortise the per-box polygon set-up. Exact for any value (the image is the
     // Basic image); 0 joins only subtrees without an empty leaf; negative: off.
     float coalesce = 0.25f;
+    // ... and only while its room is at most this many cells on every axis, so occlusion culling
+    // and clipping keep boxes fine enough to cull.
+    int coalesce_edge = 64;
     int threads = 0;              // 0 = all
 };
 // Throws lacuna::Error naming the CLI option ("--spread", ...) for a bad value.
@@ -118,9 +121,9 @@ std::vector<BoxInfo> grow_boxes(const BoxMeasure& m);
 
 // Per transfer function, which boxes are empty. Built once per box list and value->LUT mapping:
 // every box keeps the exact union of the LUT-entry ranges of its cells (for_each_cell_row, the
-// ranges every skipping structure uses), taken over the box grown by one cell past each upper
-// face (clipped to the grid): a sample inside the box [lo, hi] reads the cell floor(p), which is
-// cell hi on an upper face (voxel hi+1 with weight zero, counted anyway to be conservative).
+// ranges every skipping structure uses). The slicer's ownership is half-open (the box [lo, hi)
+// of cells owns samples lo <= p < hi; the sampler clamps the volume's last voxel to the last
+// cell), so every sample a box takes reads one of the box's own cells.
 // Per TF a box is empty exactly when the TF opacity is zero on every entry of that union: the
 // same answer as asking each of those cells, in O(intervals) with the opacity prefix count.
 class BoxClassifier {

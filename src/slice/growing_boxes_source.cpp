@@ -103,7 +103,8 @@ GrowingBoxesSource::GrowingBoxesSource(const Volume& v, const BoxesOptions& o)
 }
 
 // Bottom-up over the tree: the non-empty cells of every subtree; a subtree with none is skipped,
-// one whose room is at most `coalesce` empty is emitted whole, others descend. Children have
+// one whose room is at most `coalesce` empty and `coalesce_edge` cells on every axis is emitted
+// whole, others descend. Children have
 // larger indices than their parent (the tree is built top-down), so a reverse sweep is
 // bottom-up.
 void GrowingBoxesSource::make_cut() {
@@ -123,7 +124,10 @@ void GrowingBoxesSource::make_cut() {
         if (full[i] == 0.0)
             m_cut[i] = BspTree::kSkip;
         else if (m_opts.coalesce >= 0.f &&
-                 full[i] >= (1.0 - double(m_opts.coalesce)) * double(box_volume(n.room)))
+                 full[i] >= (1.0 - double(m_opts.coalesce)) * double(box_volume(n.room)) &&
+                 n.room.hi[0] - n.room.lo[0] <= m_opts.coalesce_edge &&
+                 n.room.hi[1] - n.room.lo[1] <= m_opts.coalesce_edge &&
+                 n.room.hi[2] - n.room.lo[2] <= m_opts.coalesce_edge)
             m_cut[i] = BspTree::kEmit;
     }
     // Count what a traversal emits (any view emits the same set).

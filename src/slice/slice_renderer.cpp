@@ -52,16 +52,23 @@ struct ScreenProjection {
     double sx, sy;  // aspect * half_h, half_h
     double w, h;
     bool persp;
+    double ku = 0, kv = 0;  // 0.5 * w / sx, 0.5 * h / sy (set by prepare())
+    void prepare() {
+        ku = 0.5 * w / sx;
+        kv = 0.5 * h / sy;
+    }
+    // One division per vertex (perspective) instead of four: polygon set-up projects every
+    // vertex of every slicing polygon. The pixels tried carry a margin; ownership decides.
     void project(const Vec3d& p, double& u, double& v) const {
         const Vec3d rel = Vec3d{p.x * sp.x, p.y * sp.y, p.z * sp.z} - eye;
         double xr = dot(rel, right), yu = dot(rel, up);
         if (persp) {
-            const double zf = dot(rel, fwd);
-            xr /= zf;
-            yu /= zf;
+            const double inv = 1.0 / dot(rel, fwd);
+            xr *= inv;
+            yu *= inv;
         }
-        u = (xr / sx + 1.0) * 0.5 * w;
-        v = (1.0 - yu / sy) * 0.5 * h;
+        u = xr * ku + 0.5 * w;
+        v = 0.5 * h - yu * kv;
     }
 };
 
@@ -113,6 +120,8 @@ void set_up_box(const Frame& f, Vec3d lo, Vec3d hi, BoxWork& out, uint64_t& poly
     const int k1 = int(std::floor(zmax / f.dt - 0.5)) + 1;
     if (k1 < k0) return;
     IncrementalSlicer slicer(lo, hi, n, (k0 + 0.5) * f.dt + g_eye, f.dt);
+    out.polys.reserve(out.polys.size() + size_t(k1 - k0 + 1));
+    out.uv.reserve(out.uv.size() + 12 * size_t(k1 - k0 + 1));  // up to 6 vertices, 2 floats
     SlicePolygon poly;
     for (int k = k0; k <= k1; ++k) {
         slicer.next(poly);
@@ -302,6 +311,7 @@ SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
     f.screen = {f.eye_world, Vec3d(cam.right()), Vec3d(cam.up()), f.fwd, sp,
                 aspect * cam.half_height(), double(cam.half_height()), double(W), double(H),
                 cam.projection() == Projection::Perspective};
+    f.screen.prepare();
 
     // 3. Occlusion: the map's geometry and each pixel's cells, the DeltaVoxels schedule.
     const bool occl = oo.mode != OcclusionMode::Off;
