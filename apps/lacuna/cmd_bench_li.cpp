@@ -7,6 +7,7 @@
 
 #include "bench/datasets.h"
 #include "bench/li.h"
+#include "bench/plot.h"
 #include "bench/report.h"
 #include "cli_common.h"
 #include "lacuna/error.h"
@@ -22,7 +23,7 @@ struct LiArgs {
     std::string datasets = "ch2-skin,ch2bet-brain,ch2better-brain,aal,tree512";
     std::string ess = "boxes";
     float step = 0.5f, threshold = 0.95f;
-    int map = 64, updates = 9, threads = 0;
+    int map = 64, updates = 9, threads = 0, updates_views = 60;
     float coalesce = BoxesOptions{}.coalesce;
     int coalesce_edge = BoxesOptions{}.coalesce_edge;
     bool no_march = false;
@@ -60,6 +61,8 @@ void run_li(const LiArgs& a) {
     o.threshold = a.threshold;
     o.map_size = a.map;
     o.initial_updates = a.updates;
+    if (a.updates_views < 0) throw Error("--updates-views", "views", "expected >= 0");
+    o.updates_views = a.updates_views;
     o.threads = a.threads;
     o.march = !a.no_march;
     o.accel.threads = a.threads;
@@ -90,7 +93,13 @@ void run_li(const LiArgs& a) {
     bench::write_text_file((dir / "li.md").string(), md);
     bench::write_text_file((dir / "li.csv").string(), bench::li_csv(rep));
     bench::write_text_file((dir / "li-updates.csv").string(), bench::li_updates_csv(rep));
-    std::printf("\n%s\nwrote li.md, li.csv, li-updates.csv in %s\n", md.c_str(), dir.c_str());
+    std::string plot = ", no plot (gnuplot not found)";
+    if (!rep.figure6.desired.empty() && bench::gnuplot_available()) {
+        bench::run_gnuplot(bench::li_updates_gnuplot(rep, (dir / "li-updates.png").string()));
+        plot = ", li-updates.png";
+    }
+    std::printf("\n%s\nwrote li.md, li.csv, li-updates.csv%s in %s\n", md.c_str(), plot.c_str(),
+                dir.c_str());
     for (const auto& d : rep.datasets)
         if (!d.ess_exact || !d.map_only_exact)
             throw Error("bench li", "exactness", d.name + ": ESS or ESS+M differs from Basic (a bug)");
@@ -121,6 +130,9 @@ void register_bench_li(CLI::App& bench) {
     c->add_option("--threshold", a->threshold, "Occlusion opacity threshold")->capture_default_str();
     c->add_option("--map", a->map, "Opacity map edge in cells")->capture_default_str();
     c->add_option("--updates", a->updates, "Initial desired map updates per frame (k)")
+        ->capture_default_str();
+    c->add_option("--updates-views", a->updates_views,
+                  "Figure 6: ESS+CC frames of a longer orbit on the first dataset (0 = none)")
         ->capture_default_str();
     c->add_option("--threads", a->threads, "Threads (0 = all)")->capture_default_str();
     c->add_flag("--no-march", a->no_march, "Skip the ray-marcher columns");

@@ -145,6 +145,33 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
                 d.columns.push_back(std::move(col));
             }
         }
+        // Figure 6: a longer orbit of ESS+CC with the adaptive controller, first dataset only.
+        if (o.updates_views > 0 && rep.datasets.empty()) {
+            OrbitSpec spec = o.orbit;
+            spec.views = o.updates_views;
+            const std::vector<Camera> long_orbit = orbit_cameras(slicer.bounds(), spec);
+            slicer.set_box_source(source.get());
+            AdaptiveOptions ao;
+            ao.initial = o.initial_updates;
+            AdaptiveUpdates controller(ao);
+            rep.figure6.dataset = ds.name;
+            for (const Camera& cam : long_orbit) {
+                SliceOptions so;
+                so.step = o.step;
+                so.ert = 2.f;
+                so.threads = o.threads;
+                so.occlusion.mode = OcclusionMode::CullClip;
+                so.occlusion.threshold = o.threshold;
+                so.occlusion.map_size = o.map_size;
+                so.occlusion.updates = o.initial_updates;
+                const SliceResult r = slicer.render(cam, so, &controller);
+                rep.figure6.desired.push_back(r.stats.desired_updates);
+                rep.figure6.actual.push_back(r.stats.map_updates);
+                rep.figure6.skipped.push_back(r.stats.skipped_fraction());
+            }
+            if (log)
+                log("  Figure 6: " + std::to_string(long_orbit.size()) + " ESS+CC frames");
+        }
         rep.datasets.push_back(std::move(d));
     }
     return rep;
@@ -270,12 +297,33 @@ std::string li_csv(const LiReport& r) {
 }
 
 std::string li_updates_csv(const LiReport& r) {
-    std::string out = "dataset,frame,desired_updates,actual_updates\n";
-    for (const LiDataset& d : r.datasets)
-        for (size_t i = 0; i < d.desired_updates.size(); ++i)
-            out += d.name + "," + std::to_string(i) + "," + std::to_string(d.desired_updates[i]) +
-                   "," + std::to_string(d.actual_updates[i]) + "\n";
+    std::string out = "dataset,frame,desired_updates,actual_updates,skipped_fraction\n";
+    const LiUpdates& u = r.figure6;
+    for (size_t i = 0; i < u.desired.size(); ++i)
+        out += u.dataset + "," + std::to_string(i) + "," + std::to_string(u.desired[i]) + "," +
+               std::to_string(u.actual[i]) + "," + fmt("%.4f", u.skipped[i]) + "\n";
     return out;
+}
+
+std::string li_updates_gnuplot(const LiReport& r, const std::string& png) {
+    const LiUpdates& u = r.figure6;
+    std::string s = "set terminal pngcairo size 900,420 font ',10'\n";
+    std::string q = "'";
+    for (char c : png) q += c == '\'' ? std::string("''") : std::string(1, c);
+    s += "set output " + q + "'\n";
+    s += "set title 'Map updates per frame, " + u.dataset + " (ESS+CC, adaptive, " +
+         std::to_string(r.options.orbit.size) + "^2, " + std::to_string(u.desired.size()) +
+         "-frame orbit)'\n";
+    s += "set xlabel 'Frame'\nset ylabel 'Map updates'\nset grid\nset key top right\n"
+         "set yrange [0:*]\n";
+    s += "$d << EOD\n";
+    for (size_t i = 0; i < u.desired.size(); ++i)
+        s += std::to_string(i) + " " + std::to_string(u.desired[i]) + " " +
+             std::to_string(u.actual[i]) + "\n";
+    s += "EOD\n";
+    s += "plot $d using 1:2 with steps lw 2 title 'desired (k)', "
+         "$d using 1:3 with linespoints pt 7 ps 0.6 title 'actual'\n";
+    return s;
 }
 
 }  // namespace lacuna::bench

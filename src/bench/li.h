@@ -33,6 +33,8 @@ struct LiOptions {
     int initial_updates = 9;  // k of the adaptive window
     int threads = 0;
     bool march = true;        // also time the ray marcher
+    int updates_views = 60;   // Figure 6: ESS+CC frames of a longer orbit on the first dataset
+                              // (0 = none)
 };
 
 struct LiColumn {
@@ -60,9 +62,18 @@ struct LiDataset {
     const LiColumn* find(const std::string& n) const;
 };
 
+// Figure 6 of the paper: desired and actual map updates per frame of an orbit (ESS+CC with the
+// adaptive controller), and the share of non-empty voxels skipped per frame.
+struct LiUpdates {
+    std::string dataset;
+    std::vector<int> desired, actual;
+    std::vector<double> skipped;
+};
+
 struct LiReport {
     LiOptions options;
     std::vector<LiDataset> datasets;
+    LiUpdates figure6;  // empty when options.updates_views == 0
 };
 
 using LiLog = std::function<void(const std::string&)>;
@@ -72,5 +83,7 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& opti
 std::string li_markdown(const LiReport& r, const RunInfo& info);
 std::string li_csv(const LiReport& r);          // one line per dataset x column
 std::string li_updates_csv(const LiReport& r);  // dataset, frame, desired, actual (Figure 6)
+// gnuplot script drawing Figure 6 (desired and actual updates per frame) into png_path.
+std::string li_updates_gnuplot(const LiReport& r, const std::string& png_path);
 
 }  // namespace lacuna::bench
