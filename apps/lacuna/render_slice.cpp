@@ -83,8 +83,10 @@ void render_slice(const SliceCliArgs& a, const SliceRenderJob& job) {
                 job.volume.path.c_str(), job.width, job.height,
                 job.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
                 tf.name.c_str(), job.accel.c_str(), resolve_threads(job.render.threads));
-    std::printf("render time %.1f ms (polygon set-up %.1f%%), %llu boxes, %llu polygons, %.1f Msamples/s\n",
-                s.seconds * 1e3, 100 * s.setup_fraction(), (unsigned long long)s.boxes,
+    std::printf("render time %.1f ms (polygon set-up %.1f%% of CPU time, %.1f%% of wall time), "
+                "%llu boxes, %llu polygons, %.1f Msamples/s\n",
+                s.seconds * 1e3, 100 * s.setup_cpu_fraction(), 100 * s.setup_fraction(),
+                (unsigned long long)s.boxes,
                 (unsigned long long)s.polygons, s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0);
     if (a.occlusion)
         std::printf("occlusion (threshold %.3g, map %dx%d): %d/%d map updates, %llu boxes culled, "

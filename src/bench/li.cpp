@@ -35,6 +35,7 @@ void finish(LiColumn& c) {
     const double n = double(std::max<size_t>(c.frame_ms.size(), 1));
     c.cpu_ms /= n;
     c.setup_fraction /= n;
+    c.setup_wall /= n;
     c.culled /= n;
     c.clipped /= n;
     c.samples /= n;
@@ -89,7 +90,8 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
                 SliceResult r = slicer.render(cams[v], so, adaptive ? &controller : nullptr);
                 col.cpu_ms += cpu_now_ms() - cpu0;
                 col.frame_ms.push_back(r.stats.seconds * 1e3);
-                col.setup_fraction += r.stats.setup_fraction();
+                col.setup_fraction += r.stats.setup_cpu_fraction();
+                col.setup_wall += r.stats.setup_fraction();
                 col.culled += r.stats.culled_fraction();
                 col.clipped += r.stats.clipped_fraction();
                 col.samples += double(r.stats.samples);
@@ -192,7 +194,7 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
            (o.threads > 0 ? std::to_string(o.threads) : "all") + ".\n\n";
 
     out += "## Table 1: empty space skipping (frames per second)\n\n";
-    out += "| dataset | size | boxes | Basic | ESS | speedup | polygon set-up (ESS) | ESS == Basic |\n";
+    out += "| dataset | size | boxes | Basic | ESS | speedup | polygon set-up (ESS), CPU / wall | ESS == Basic |\n";
     out += "|---|---|---:|---:|---:|---:|---:|---|\n";
     double sum_ess = 0;
     for (const LiDataset& d : r.datasets) {
@@ -202,7 +204,8 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
         out += "| " + d.name + " | " + std::to_string(d.dims.x) + "×" + std::to_string(d.dims.y) +
                "×" + std::to_string(d.dims.z) + " | " + std::to_string(d.boxes) + " | " +
                fmt("%.2f", fps(b)) + " | " + fmt("%.2f", fps(e)) + " | " + fmt("%.2f", s) +
-               " | " + fmt("%.1f%%", 100 * (e ? e->setup_fraction : 0)) + " | " +
+               " | " + fmt("%.1f%%", 100 * (e ? e->setup_fraction : 0)) + " / " +
+               fmt("%.1f%%", 100 * (e ? e->setup_wall : 0)) + " | " +
                (d.ess_exact ? "yes" : "**NO**") + " |\n";
     }
     if (!r.datasets.empty())
@@ -286,7 +289,7 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
 
 std::string li_csv(const LiReport& r) {
     std::string out =
-        "dataset,column,mean_ms,cpu_ms,fps,setup_fraction,culled,clipped,samples_per_frame\n";
+        "dataset,column,mean_ms,cpu_ms,fps,setup_cpu_fraction,culled,clipped,samples_per_frame\n";
     for (const LiDataset& d : r.datasets)
         for (const LiColumn& c : d.columns)
             out += d.name + "," + c.name + "," + fmt("%.3f", c.mean_ms) + "," +

@@ -43,7 +43,8 @@ struct LiColumn {
     double mean_ms = 0;
     double cpu_ms = 0;          // mean process CPU time per frame (all threads; robust to a
                                 // machine shared with other jobs)
-    double setup_fraction = 0;  // mean polygon set-up share of the frame
+    double setup_fraction = 0;  // mean polygon set-up share of the frame's CPU time
+    double setup_wall = 0;      // ... of its wall time (depends on thread scheduling)
     double culled = 0, clipped = 0;  // mean shares of non-empty voxels
     double samples = 0;             // mean composited samples per frame
 };

@@ -1,5 +1,7 @@
 #include "core/parallel.h"
 
+#include <ctime>
+
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -39,6 +41,18 @@ void parallel_for(size_t n, int threads, const std::function<void(size_t, size_t
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain),
                           [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); });
     });
+}
+
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+double process_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 }  // namespace lacuna

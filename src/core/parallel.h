@@ -17,4 +17,9 @@ void parallel_for_tiles(int width, int height, int tile, int threads,
 void parallel_for(size_t n, int threads, const std::function<void(size_t, size_t)>& fn,
                   size_t grain = 1);
 
+// CPU time consumed so far by the calling thread, and by the whole process (all threads), in
+// seconds: for "share of the work" measures that do not depend on how threads were scheduled.
+double thread_cpu_seconds();
+double process_cpu_seconds();
+
 }  // namespace lacuna

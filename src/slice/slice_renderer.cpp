@@ -17,9 +17,11 @@ namespace lacuna {
 std::string to_string(const SliceStats& s) {
     char buf[320];
     std::snprintf(buf, sizeof buf,
-                  "%.1f ms (set-up %.1f%%, occlusion %.1f ms), %llu samples, %llu polygons, "
+                  "%.1f ms (set-up %.1f%% of CPU, %.1f%% of wall; occlusion %.1f ms), %llu samples, "
+                  "%llu polygons, "
                   "%llu boxes (%llu culled, %llu clipped), %.1f%% voxels skipped, %d/%d map updates",
-                  s.seconds * 1e3, 100 * s.setup_fraction(), s.occlusion_seconds * 1e3,
+                  s.seconds * 1e3, 100 * s.setup_cpu_fraction(), 100 * s.setup_fraction(),
+                  s.occlusion_seconds * 1e3,
                   (unsigned long long)s.samples, (unsigned long long)s.polygons,
                   (unsigned long long)s.boxes, (unsigned long long)s.boxes_culled,
                   (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction(), s.map_updates,
@@ -257,6 +259,7 @@ SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
         if (oo.updates < 0) throw Error("occlusion", "updates", "expected >= 0");
     }
     const auto t_start = Clock::now();
+    const double cpu_start = process_cpu_seconds();
     const int W = cam.width(), H = cam.height();
     const size_t np = size_t(W) * size_t(H);
     SliceResult out;
@@ -387,10 +390,14 @@ SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
         // 4b. Slicing polygons of every box in the batch (incremental intersection).
         const auto t_setup = Clock::now();
         std::vector<uint64_t> polys(work.size(), 0);
+        std::atomic<int64_t> setup_cpu_ns{0};
         parallel_for(work.size(), opt.threads, [&](size_t b0, size_t b1) {
+            const double c0 = thread_cpu_seconds();
             for (size_t b = b0; b < b1; ++b)
                 set_up_box(f, regions[b].first, regions[b].second, work[b], polys[b]);
+            setup_cpu_ns += int64_t(1e9 * (thread_cpu_seconds() - c0));
         });
+        st.setup_cpu_seconds += 1e-9 * double(setup_cpu_ns.load());
         for (uint64_t n : polys) st.polygons += n;
         st.setup_seconds += seconds_since(t_setup);
 
@@ -443,6 +450,7 @@ SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
     }
     st.samples = samples;
     st.seconds = seconds_since(t_start);
+    st.cpu_seconds = process_cpu_seconds() - cpu_start;
     if (adaptive && occl) adaptive->report(st.skipped_fraction(), st.map_updates);
     return out;
 }

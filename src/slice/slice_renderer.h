@@ -21,6 +21,7 @@
 // Occlusion batches (boxes between two map updates) are rendered one after the other, so the
 // bytes never depend on the thread count.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -47,6 +48,8 @@ struct SliceOptions {
 struct SliceStats {
     double seconds = 0;            // whole frame
     double setup_seconds = 0;      // slicing polygons (incremental intersection + projection)
+    double cpu_seconds = 0;        // process CPU time of the frame (all threads)
+    double setup_cpu_seconds = 0;  // CPU time of the slicing polygons (all threads)
     double occlusion_seconds = 0;  // map updates, culling and clipping
     uint64_t samples = 0;          // composited samples
     uint64_t polygons = 0;         // non-empty slicing polygons
@@ -55,6 +58,10 @@ struct SliceStats {
     double voxels_culled = 0, voxels_clipped = 0;
     int desired_updates = 0, map_updates = 0;
     double setup_fraction() const { return seconds > 0 ? setup_seconds / seconds : 0; }
+    // Share of the frame's CPU time: what the polygons cost, whatever the thread scheduling.
+    double setup_cpu_fraction() const {
+        return cpu_seconds > 0 ? std::min(1.0, setup_cpu_seconds / cpu_seconds) : 0;
+    }
     double culled_fraction() const { return voxels > 0 ? voxels_culled / voxels : 0; }
     double clipped_fraction() const { return voxels > 0 ? voxels_clipped / voxels : 0; }
     double skipped_fraction() const { return culled_fraction() + clipped_fraction(); }

@@ -41,6 +41,12 @@ TEST(BenchLi, TinyRunHasEveryColumnIsExactAndRecordsFigure6) {
     EXPECT_LE(d.find("ESS")->samples, d.find("Basic")->samples);
     EXPECT_LE(d.find("ESS+CC")->samples, d.find("ESS")->samples);
     EXPECT_GT(d.boxes, 0u);
+    // Polygon set-up is measured (CPU and wall shares of the frame).
+    for (const char* c : {"ESS", "Basic"}) {
+        EXPECT_GT(d.find(c)->setup_fraction, 0.0) << c;
+        EXPECT_LT(d.find(c)->setup_fraction, 1.0) << c;
+        EXPECT_GT(d.find(c)->setup_wall, 0.0) << c;
+    }
     // Figure 6: one entry per frame; the actual updates never exceed the desired ones.
     const LiUpdates& u = rep.figure6;
     EXPECT_EQ(u.dataset, "shells");
