@@ -25,7 +25,7 @@ struct LiArgs {
     float step = 0.5f, threshold = 0.95f;
     int map = 64, updates = 9, threads = 0, updates_views = 60;
     float coalesce = BoxesOptions{}.coalesce;
-    int coalesce_edge = BoxesOptions{}.coalesce_edge;
+    float coalesce_edge = BoxesOptions{}.coalesce_edge;
     bool no_march = false;
     std::string out_dir = "out/bench";
     std::string templates = bench::DatasetSource{}.templates_dir;
@@ -124,7 +124,7 @@ void register_bench_li(CLI::App& bench) {
                   "ESS boxes: a BSP subtree at most this share empty is one box (negative: off)")
         ->capture_default_str();
     c->add_option("--coalesce-edge", a->coalesce_edge,
-                  "ESS boxes: largest joined box, cells per axis")
+                  "ESS boxes: largest joined box, per axis in world units (mm)")
         ->capture_default_str();
     c->add_option("--step", a->step, "Slice distance in voxels")->capture_default_str();
     c->add_option("--threshold", a->threshold, "Occlusion opacity threshold")->capture_default_str();

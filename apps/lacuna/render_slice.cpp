@@ -26,7 +26,7 @@ void add_slice_options(CLI::App& cmd, SliceCliArgs& a) {
                    "share of it is empty (exact for any value; negative: every leaf alone)")
         ->capture_default_str();
     cmd.add_option("--coalesce-edge", a.coalesce_edge,
-                   "Slicer, --accel boxes: largest box --coalesce makes, cells per axis")
+                   "Slicer, --accel boxes: largest box --coalesce makes, per axis in world units (mm)")
         ->capture_default_str();
 }
 

@@ -15,7 +15,7 @@ struct SliceCliArgs {
     float occlusion_threshold = 0.95f;
     int occlusion_map = 64;
     float coalesce = BoxesOptions{}.coalesce;
-    int coalesce_edge = BoxesOptions{}.coalesce_edge;
+    float coalesce_edge = BoxesOptions{}.coalesce_edge;
     bool threshold_given = false, map_given = false, coalesce_given = false;
 };
 void add_slice_options(CLI::App& cmd, SliceCliArgs& a);

@@ -293,17 +293,17 @@ void validate(const BoxesOptions& o) {
     if (o.thin < 0 || o.thin > 4096) throw bad("--thin", "0..4096 cells", o.thin);
     if (o.threads < 0) throw bad("--threads", ">= 0", o.threads);
     if (!(o.coalesce <= 1.f)) throw bad("--coalesce", "a share <= 1 (negative: off)", o.coalesce);
-    if (o.coalesce_edge < 1) throw bad("--coalesce-edge", ">= 1 cells", o.coalesce_edge);
+    if (!(o.coalesce_edge > 0.f)) throw bad("--coalesce-edge", "a length > 0 (mm)", o.coalesce_edge);
 }
 
 std::string to_string(const BoxesOptions& o) {
     char buf[240];
     std::snprintf(buf, sizeof buf,
                   "spread %g/256, min box %d, gradient %g, gradient waste %g, other cost %g, "
-                  "thin %d, merge %s, coalesce %g up to %d cells",
+                  "thin %d, merge %s, coalesce %g up to %g mm",
                   double(o.spread), o.min_uniform, double(o.gradient), double(o.gradient_waste),
                   double(o.other_cost), o.thin, o.merge ? "on" : "off", double(o.coalesce),
-                  o.coalesce_edge);
+                  double(o.coalesce_edge));
     return buf;
 }
 

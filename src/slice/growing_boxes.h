@@ -61,9 +61,10 @@ struct BoxesOptions {
     // larger boxes amortise the per-box polygon set-up. Exact for any value (the image is the
     // Basic image); 0 joins only subtrees without an empty leaf; negative: off.
     float coalesce = 0.25f;
-    // ... and only while its room is at most this many cells on every axis, so occlusion culling
-    // and clipping keep boxes fine enough to cull.
-    int coalesce_edge = 64;
+    // ... and only while its room is at most this long on every axis, in world units (mm; cells
+    // times spacing): boxes stay fine enough for occlusion culling and clipping, and about as
+    // large on screen whatever the voxel size.
+    float coalesce_edge = 64.f;
     int threads = 0;              // 0 = all
 };
 // Throws lacuna::Error naming the CLI option ("--spread", ...) for a bad value.

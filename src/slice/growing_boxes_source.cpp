@@ -103,13 +103,20 @@ GrowingBoxesSource::GrowingBoxesSource(const Volume& v, const BoxesOptions& o)
 }
 
 // Bottom-up over the tree: the non-empty cells of every subtree; a subtree with none is skipped,
-// one whose room is at most `coalesce` empty and `coalesce_edge` cells on every axis is emitted
+// one whose room is at most `coalesce` empty and `coalesce_edge` long (world units) on every
+// axis is emitted
 // whole, others descend. Children have
 // larger indices than their parent (the tree is built top-down), so a reverse sweep is
 // bottom-up.
 void GrowingBoxesSource::make_cut() {
     const std::vector<BspNode>& nodes = m_tree.nodes();
     std::vector<double> full(nodes.size(), 0.0);
+    const Vec3d sp = m_volume.spacing;
+    auto short_enough = [&](const CellBox& r) {
+        for (int a = 0; a < 3; ++a)
+            if (double(r.hi[a] - r.lo[a]) * sp[a] > double(m_opts.coalesce_edge)) return false;
+        return true;
+    };
     m_cut.assign(nodes.size(), BspTree::kDescend);
     for (size_t i = nodes.size(); i-- > 0;) {
         const BspNode& n = nodes[i];
@@ -125,9 +132,7 @@ void GrowingBoxesSource::make_cut() {
             m_cut[i] = BspTree::kSkip;
         else if (m_opts.coalesce >= 0.f &&
                  full[i] >= (1.0 - double(m_opts.coalesce)) * double(box_volume(n.room)) &&
-                 n.room.hi[0] - n.room.lo[0] <= m_opts.coalesce_edge &&
-                 n.room.hi[1] - n.room.lo[1] <= m_opts.coalesce_edge &&
-                 n.room.hi[2] - n.room.lo[2] <= m_opts.coalesce_edge)
+                 short_enough(n.room))
             m_cut[i] = BspTree::kEmit;
     }
     // Count what a traversal emits (any view emits the same set).

@@ -61,7 +61,7 @@ inline BoxesOptions random_options(Rng& rng) {
     o.merge = !rng.coin(4);
     const float coalesce[] = {-1.f, 0.f, 0.1f, 0.25f, 0.5f, 1.f};
     o.coalesce = coalesce[rng.range(0, 5)];
-    o.coalesce_edge = rng.coin() ? 32 : rng.range(1, 16);
+    o.coalesce_edge = rng.coin() ? 32.f : float(rng.range(1, 16)) * 0.75f;
     o.threads = rng.range(1, 2);
     return o;
 }

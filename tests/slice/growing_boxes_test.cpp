@@ -309,16 +309,19 @@ TEST(GrowingBoxesSource, ReturnsDisjointNonEmptyBoxesInVisibilityOrderCoveringVi
 
 // Coalescing (BoxesOptions::coalesce): every emitted box is a BSP room that holds every visible
 // leaf inside it (each in exactly one box), at most `coalesce` of its cells in empty leaves
-// (0: none) and, when it joins leaves, at most coalesce_edge cells per axis; off (< 0) emits
+// (0: none) and, when it joins leaves, at most coalesce_edge long per axis (cells x spacing);
+// off (< 0) emits
 // exactly the non-empty leaves; 1 without an edge limit emits one box.
 TEST(GrowingBoxesSource, CoalescedBoxesAreRoomsWithinTheEmptyShare) {
     Rng rng{43};
     for (int iter = 0; iter < 30; ++iter) {
-        const Volume v = adversarial_volume(iter % 6, accel_test::kAllTypes[iter % 4], rng);
+        Volume v = adversarial_volume(iter % 6, accel_test::kAllTypes[iter % 4], rng);
+        if (iter % 2 == 1)  // anisotropic voxels: the edge limit is in world units
+            v.spacing = Vec3d{0.5 + rng.uniform(), 0.5 + rng.uniform(), 0.3 + 2 * rng.uniform()};
         BoxesOptions o = random_options(rng);
         const float shares[] = {-1.f, 0.f, 0.2f, 0.6f, 1.f};
         o.coalesce = shares[iter % 5];
-        o.coalesce_edge = iter % 3 == 0 ? 1 << 20 : rng.range(1, 12);
+        o.coalesce_edge = iter % 3 == 0 ? 1e9f : float(rng.range(1, 12)) * 0.7f;
         GrowingBoxesSource src(v, o);
         src.set_transfer_function(accel_test::random_lut(v.vis_range(), kDefaultLutSize, rng));
         const std::string what = "iter " + std::to_string(iter) + " coalesce " +
@@ -344,7 +347,8 @@ TEST(GrowingBoxesSource, CoalescedBoxesAreRoomsWithinTheEmptyShare) {
             ASSERT_GT(full[b], 0.0) << what << ": an emitted box without a visible leaf";
             if (leaves_in[b] > 1 || full[b] < vol)  // joined: within the edge limit
                 for (int a = 0; a < 3; ++a)
-                    ASSERT_LE(boxes[b].hi[a] - boxes[b].lo[a], o.coalesce_edge)
+                    ASSERT_LE(double(boxes[b].hi[a] - boxes[b].lo[a]) * v.spacing[a],
+                              double(o.coalesce_edge))
                         << what << ": box " << to_string(boxes[b]);
             if (o.coalesce >= 0.f)
                 ASSERT_GE(full[b], (1.0 - double(o.coalesce)) * vol - 1e-9)
@@ -353,7 +357,7 @@ TEST(GrowingBoxesSource, CoalescedBoxesAreRoomsWithinTheEmptyShare) {
                 ASSERT_EQ(full[b], vol) << what;
         }
         if (o.coalesce < 0.f) ASSERT_EQ(boxes.size(), nonempty_leaves) << what;
-        if (o.coalesce >= 1.f && o.coalesce_edge >= 1 << 20 && nonempty_leaves > 0)
+        if (o.coalesce >= 1.f && o.coalesce_edge >= 1e9f && nonempty_leaves > 0)
             ASSERT_EQ(boxes.size(), 1u) << what;
     }
 }
