@@ -9,6 +9,7 @@
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "slice/box_sources.h"
+#include "slice/growing_boxes_source.h"
 #include "slice/slice_renderer.h"
 
 namespace lacuna::bench {
@@ -66,6 +67,11 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
         source->set_transfer_function(ds.lut);
         d.source_ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3;
         const std::vector<Camera> cams = orbit_cameras(slicer.bounds(), o.orbit);
+        if (const auto* gb = dynamic_cast<const GrowingBoxesSource*>(source.get())) {
+            const BoxesBuildStats& bs = gb->stats();
+            d.partition_ms = 1e3 * (bs.gradient + bs.grow + bs.measure + bs.ranges);
+            d.bsp_ms = 1e3 * (bs.split + bs.merge);
+        }
         if (log) log(ds.name + ": " + o.ess + " boxes built in " + fmt("%.1f", d.source_ms) + " ms");
 
         Image basic0, ess0, map0, cc0;
@@ -260,7 +266,7 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
     }
     out += "\n(ms of CPU per frame.)\n\n";
     out += "## Details\n\n";
-    out += "| dataset | TF | source build [ms] | box voxels % | Basic [ms] | ESS [ms] | ESS+CC [ms] | "
+    out += "| dataset | TF | source build [ms] (partition + BSP) | box voxels % | Basic [ms] | ESS [ms] | ESS+CC [ms] | "
            "ESS+M [ms] | ESS+C [ms] | march none [ms] | march ESS [ms] | ESS+M == ESS | max "
            "|ESS+CC − ESS| (8 bit) | map updates desired/actual (mean) |\n";
     out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|\n";
@@ -275,7 +281,11 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
             act += d.actual_updates[i];
         }
         const double n = double(std::max<size_t>(d.desired_updates.size(), 1));
-        out += "| " + d.name + " | " + d.tf_name + " | " + fmt("%.1f", d.source_ms) + " | " +
+        const std::string parts =
+            d.partition_ms >= 0
+                ? " (" + fmt("%.1f", d.partition_ms) + " + " + fmt("%.1f", d.bsp_ms) + ")"
+                : "";
+        out += "| " + d.name + " | " + d.tf_name + " | " + fmt("%.1f", d.source_ms) + parts + " | " +
                fmt("%.1f", 100 * d.box_voxels) + " | " + ms("Basic") + " | " + ms("ESS") + " | " +
                ms("ESS+CC") + " | " + ms("ESS+M") + " | " + ms("ESS+C") + " | " +
                ms("march none") + " | " + ms(("march " + o.ess).c_str()) + " | " +

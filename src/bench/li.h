@@ -53,6 +53,9 @@ struct LiDataset {
     std::string name, description, tf_name;
     Vec3i dims{0, 0, 0};
     double source_ms = 0;  // building the box source and applying the TF
+    // Growing boxes only: the partition (gradient cells, growth, measuring the BSP pieces, the
+    // per-box LUT ranges) and the BSP tree (splitting and merging), from BoxesBuildStats.
+    double partition_ms = -1, bsp_ms = -1;
     size_t boxes = 0;      // boxes of view 0
     double box_voxels = 0; // share of the volume's cells inside the boxes
     std::vector<LiColumn> columns;  // Basic, ESS, ESS+CC, ESS+M, ESS+C, march none, march ESS

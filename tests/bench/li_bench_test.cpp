@@ -41,6 +41,10 @@ TEST(BenchLi, TinyRunHasEveryColumnIsExactAndRecordsFigure6) {
     EXPECT_LE(d.find("ESS")->samples, d.find("Basic")->samples);
     EXPECT_LE(d.find("ESS+CC")->samples, d.find("ESS")->samples);
     EXPECT_GT(d.boxes, 0u);
+    // Growing boxes: partition and BSP build times are reported and within the source's build.
+    EXPECT_GE(d.partition_ms, 0.0);
+    EXPECT_GE(d.bsp_ms, 0.0);
+    EXPECT_LE(d.partition_ms + d.bsp_ms, d.source_ms + 1e-6);
     // Polygon set-up is measured (CPU and wall shares of the frame).
     for (const char* c : {"ESS", "Basic"}) {
         EXPECT_GT(d.find(c)->setup_fraction, 0.0) << c;
