@@ -2,9 +2,12 @@
 // stretches [t0, t1] of a ray that may hold visible samples, front to back.
 //
 // Exactness argument. The cursor only ever removes open intervals (s0, s1) that lie strictly
-// inside an empty region's box, shrunk by kMargin voxels on every side; positions computed in
-// float for any t there stay inside the box (float error << kMargin), so their trilinear cell is
-// one of the region's empty cells. Everything else of [t_near, t_far] is returned, so the ray
+// inside an empty region's box, shrunk by kMargin voxels on every side that has a neighbour
+// cell; positions computed in float for any t there stay inside the box (float error <<
+// kMargin), so their trilinear cell is one of the region's empty cells. A face on the grid's
+// border needs no margin: the sampler clamps positions into the grid, so a position past that
+// face still reads the border cell, which is the region's. (Without this, every ray kept about
+// one sample at each end of the volume even when the whole volume is empty.) Everything else of [t_near, t_far] is returned, so the ray
 // marcher (which rounds segments outward to lattice samples) takes every sample the reference
 // takes that could be visible. How the cursor walks (nudges, minimum advances) affects speed,
 // never the image.
@@ -55,6 +58,7 @@ public:
         const int* n = s.cells();
         for (int a = 0; a < 3; ++a) {
             m_hi[a] = float(n[a]);
+            m_cells[a] = n[a];
             m_last[a] = n[a] - 1;
             m_inv[a] = r.d[a] == 0.f ? 0.f : 1.f / r.d[a];
         }
@@ -73,19 +77,26 @@ public:
             }
             // 2. Ask the structure; intersect the ray with the region's box.
             const Region reg = m_s.region(cell, m_hint);
+            // A face on the grid border is never crossed into another cell (positions clamp):
+            // its parameter is -inf (entry) or +inf (exit).
             float ta = -INFINITY, tb = INFINITY;
             for (int a = 0; a < 3; ++a) {
                 if (m_r.d[a] == 0.f) continue;
-                float t0 = (float(reg.box.lo[a]) - m_r.o[a]) * m_inv[a];
-                float t1 = (float(reg.box.hi[a]) - m_r.o[a]) * m_inv[a];
-                if (t0 > t1) std::swap(t0, t1);
-                ta = std::max(ta, t0);
-                tb = std::min(tb, t1);
+                const bool up = m_r.d[a] > 0.f;
+                const float t_lo = reg.box.lo[a] <= 0
+                                       ? (up ? -INFINITY : INFINITY)
+                                       : (float(reg.box.lo[a]) - m_r.o[a]) * m_inv[a];
+                const float t_hi = reg.box.hi[a] >= m_cells[a]
+                                       ? (up ? INFINITY : -INFINITY)
+                                       : (float(reg.box.hi[a]) - m_r.o[a]) * m_inv[a];
+                ta = std::max(ta, std::min(t_lo, t_hi));
+                tb = std::min(tb, std::max(t_lo, t_hi));
             }
             const float t_next = std::max(tb, m_t + m_nudge_t);
             // 3. Empty: cut the interval strictly inside the box out of the ray.
             if (reg.empty) {
-                const float s0 = std::max(ta, m_t) + m_margin_t, s1 = tb - m_margin_t;
+                const float s0 = std::min(std::max(ta + m_margin_t, m_t), m_far);
+                const float s1 = tb - m_margin_t;
                 m_t = t_next;
                 if (s1 - s0 > m_min_skip) {
                     const Segment seg{m_seg_start, s0};
@@ -118,7 +129,7 @@ private:
     float m_min_skip, m_chunk;
     float m_margin_t, m_nudge_t;
     float m_hi[3], m_inv[3];
-    int m_last[3];
+    int m_last[3], m_cells[3];
     int m_hint = -1;
     bool m_done = false;
 };
