@@ -2,14 +2,13 @@
 // into typed options; the benchmarks live in src/bench/.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "bench/datasets.h"
 #include "bench/faludi.h"
 #include "bench/plot.h"
 #include "bench/report.h"
 #include "bench/sweep.h"
+#include "bench_cli.h"
 #include "cli_common.h"
 #include "lacuna/error.h"
 
@@ -41,21 +40,9 @@ struct FaludiArgs {
     float shadow_step = 1.f;
 };
 
-std::vector<std::string> split_list(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream in(s);
-    for (std::string item; std::getline(in, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
 std::vector<int> parse_int_list(const std::string& s, const std::string& where) {
     std::vector<int> out;
-    for (const std::string& item : split_list(s)) {
-        if (item.find_first_not_of("0123456789") != std::string::npos || item.size() > 6)
-            throw Error(where, "list", "expected comma-separated integers, got '" + s + "'");
-        out.push_back(std::stoi(item));
-    }
+    for (const std::string& item : split_list(s)) out.push_back(parse_count(item, where, s));
     if (out.empty()) throw Error(where, "list", "expected at least one value");
     return out;
 }
@@ -81,24 +68,6 @@ std::vector<bench::DatasetId> parse_datasets(const std::string& s, const std::st
     return out;
 }
 
-// The exact command line, from /proc/self/cmdline (arguments with spaces are quoted).
-std::string command_line() {
-    std::ifstream f("/proc/self/cmdline", std::ios::binary);
-    std::string all((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    std::string out;
-    std::stringstream in(all);
-    for (std::string arg; std::getline(in, arg, '\0');) {
-        if (!out.empty()) out += ' ';
-        out += arg.find_first_of(" \t'\"") == std::string::npos ? arg : "'" + arg + "'";
-    }
-    return out.empty() ? "lacuna bench faludi" : out;
-}
-
-void log_line(const std::string& s) {
-    std::printf("%s\n", s.c_str());
-    std::fflush(stdout);
-}
-
 void run_table(const FaludiArgs& a, const bench::OrbitSpec& orbit, const AccelOptions& ao,
                const std::filesystem::path& dir) {
     bench::FaludiOptions fo;
@@ -120,7 +89,7 @@ void run_table(const FaludiArgs& a, const bench::OrbitSpec& orbit, const AccelOp
         throw Error("--shadow-step", "step", "expected 0 < step <= 64");
     fo.shadow_step = a.shadow_step;
     const auto ids = parse_datasets(a.datasets, "--datasets");
-    bench::RunInfo info = bench::collect_run_info(command_line());
+    bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench faludi"));
     std::printf("lacuna bench faludi: %dx%d, %d views, %zu datasets, %s, %d threads\n", orbit.size,
                 orbit.size, orbit.views, ids.size(), info.cpu.c_str(), info.cores);
     bench::DatasetSource src;
@@ -159,7 +128,7 @@ void run_sweep(const FaludiArgs& a, const bench::OrbitSpec& orbit,
     so.step = a.step;
     so.threads = a.threads;
     const auto ids = parse_datasets(a.sweep_datasets, "--sweep-dataset");
-    bench::RunInfo info = bench::collect_run_info(command_line());
+    bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench faludi"));
     std::printf("lacuna bench faludi --sweep: %dx%d, %d views, %zu datasets, %s, %d threads\n",
                 orbit.size, orbit.size, orbit.views, ids.size(), info.cpu.c_str(), info.cores);
     bench::DatasetSource src;
@@ -215,11 +184,7 @@ void run_faludi(FaludiArgs& a) {
     ao.initial_level = a.initial_level;
     ao.bidirectional = !a.top_down;
     ao.threads = a.threads;
-    const std::filesystem::path dir(a.out_dir);
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec || !std::filesystem::is_directory(dir))
-        throw Error(a.out_dir, "--out-dir", "cannot create the folder");
+    const std::filesystem::path dir = create_out_dir(a.out_dir);
     if (a.sweep)
         run_sweep(a, orbit, dir);
     else

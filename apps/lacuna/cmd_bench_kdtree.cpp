@@ -2,12 +2,11 @@
 // docs/benchmarks.md).
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 
 #include "bench/kdtree_bench.h"
 #include "bench/report.h"
+#include "bench_cli.h"
 #include "cli_common.h"
 #include "lacuna/error.h"
 
@@ -28,51 +27,20 @@ struct KdBenchArgs {
     bool quick = false;
 };
 
-std::vector<std::string> split_commas(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream in(s);
-    for (std::string item; std::getline(in, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
-
-int parse_count(const std::string& item, const std::string& where, const std::string& list) {
-    if (item.empty() || item.size() > 6 || item.find_first_not_of("0123456789") != std::string::npos)
-        throw Error(where, "list", "expected comma-separated integers, got '" + list + "'");
-    return std::stoi(item);
-}
-
-std::string command_line() {
-    std::ifstream f("/proc/self/cmdline", std::ios::binary);
-    std::string all((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    std::string out;
-    std::stringstream in(all);
-    for (std::string arg; std::getline(in, arg, '\0');) {
-        if (!out.empty()) out += ' ';
-        out += arg.find_first_of(" \t'\"") == std::string::npos ? arg : "'" + arg + "'";
-    }
-    return out.empty() ? "lacuna bench kdtree" : out;
-}
-
-void log_line(const std::string& s) {
-    std::printf("%s\n", s.c_str());
-    std::fflush(stdout);
-}
-
 void run_kdtree_bench(const KdBenchArgs& a) {
     bench::KdBenchOptions o;
     o.datasets.clear();
-    for (const std::string& n : split_commas(a.datasets))
+    for (const std::string& n : split_list(a.datasets))
         o.datasets.push_back(bench::parse_kd_dataset(n, "--datasets"));
     if (o.datasets.empty()) throw Error("--datasets", "list", "expected at least one dataset");
     o.sizes.clear();
-    for (const std::string& n : split_commas(a.sizes)) {
+    for (const std::string& n : split_list(a.sizes)) {
         o.sizes.push_back(parse_count(n, "--sizes", a.sizes));
         if (o.sizes.back() < 3 || o.sizes.back() > 1024)
             throw Error("--sizes", "size", "expected 3..1024, got " + n);
     }
     o.max_boxes.clear();
-    for (const std::string& n : split_commas(a.max_boxes)) {
+    for (const std::string& n : split_list(a.max_boxes)) {
         const int m = n == "all" ? 0 : parse_count(n, "--max-boxes", a.max_boxes);
         if (n != "all" && m < 1)
             throw Error("--max-boxes", "M", "expected M >= 1 or 'all', got '" + n + "'");
@@ -100,12 +68,8 @@ void run_kdtree_bench(const KdBenchArgs& a) {
     o.source.templates_dir = a.templates;
     o.source.threads = a.threads;
 
-    const std::filesystem::path dir(a.out_dir);
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec || !std::filesystem::is_directory(dir))
-        throw Error(a.out_dir, "--out-dir", "cannot create the folder");
-    bench::RunInfo info = bench::collect_run_info(command_line());
+    const std::filesystem::path dir = create_out_dir(a.out_dir);
+    bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench kdtree"));
     std::printf("lacuna bench kdtree: %zu datasets x %zu sizes, %dx%d px, %d views, %s, %d threads\n",
                 o.datasets.size(), o.sizes.size(), o.orbit.size, o.orbit.size, o.orbit.views,
                 info.cpu.c_str(), info.cores);

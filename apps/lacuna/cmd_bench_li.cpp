@@ -2,13 +2,12 @@
 // (src/bench/li.h). Flags become typed options here.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "bench/datasets.h"
 #include "bench/li.h"
 #include "bench/plot.h"
 #include "bench/report.h"
+#include "bench_cli.h"
 #include "cli_common.h"
 #include "lacuna/error.h"
 #include "slice/box_sources.h"
@@ -30,15 +29,6 @@ struct LiArgs {
     std::string out_dir = "out/bench";
     std::string templates = bench::DatasetSource{}.templates_dir;
 };
-
-std::string li_command_line() {
-    std::ifstream f("/proc/self/cmdline", std::ios::binary);
-    std::string all((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    std::string out;
-    std::stringstream in(all);
-    for (std::string arg; std::getline(in, arg, '\0');) out += (out.empty() ? "" : " ") + arg;
-    return out.empty() ? "lacuna bench li" : out;
-}
 
 void run_li(const LiArgs& a) {
     bench::LiOptions o;
@@ -67,27 +57,17 @@ void run_li(const LiArgs& a) {
     o.march = !a.no_march;
     o.accel.threads = a.threads;
     std::vector<bench::DatasetId> ids;
-    std::stringstream in(a.datasets);
-    for (std::string n; std::getline(in, n, ',');)
-        if (!n.empty()) ids.push_back(bench::parse_dataset(n));
+    for (const std::string& n : split_list(a.datasets)) ids.push_back(bench::parse_dataset(n));
     if (ids.empty()) throw Error("--datasets", "datasets", "expected at least one");
-    const std::filesystem::path dir(a.out_dir);
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec || !std::filesystem::is_directory(dir))
-        throw Error(a.out_dir, "--out-dir", "cannot create the folder");
-    bench::RunInfo info = bench::collect_run_info(li_command_line());
+    const std::filesystem::path dir = create_out_dir(a.out_dir);
+    bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench li", ArgQuoting::Plain));
     std::printf("lacuna bench li: %dx%d, %d views, %zu datasets, ESS = %s, %s, %d threads\n",
                 a.size, a.size, a.views, ids.size(), a.ess.c_str(), info.cpu.c_str(), info.cores);
-    auto log = [](const std::string& s) {
-        std::printf("%s\n", s.c_str());
-        std::fflush(stdout);
-    };
     bench::DatasetSource src;
     src.templates_dir = a.templates;
     src.threads = a.threads;
-    const auto datasets = bench::load_datasets(ids, src, log);
-    const bench::LiReport rep = bench::run_li(datasets, o, log);
+    const auto datasets = bench::load_datasets(ids, src, log_line);
+    const bench::LiReport rep = bench::run_li(datasets, o, log_line);
     info.load_end = bench::current_load();
     const std::string md = bench::li_markdown(rep, info);
     bench::write_text_file((dir / "li.md").string(), md);
