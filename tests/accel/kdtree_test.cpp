@@ -6,18 +6,16 @@
 #include "accel/kdtree.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <set>
-#include <sstream>
 
 #include "accel/kdtree_partition.h"
 #include "accel/summed_volume_table.h"
 #include "accel_test_util.h"
+#include "apps/cli_run.h"
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "lacuna/synthetic.h"
@@ -791,34 +789,15 @@ TEST(KdTreePartition, FewBoxesRemoveMostOfTheEmptySpaceOfASparseTree) {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+using CliRun = lacuna::test::CliResult;
+std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
 
 fs::path temp_dir() {
-    static fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("lacuna-kdtree-" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = lacuna::test::cli_temp_dir("kdtree");
     return dir;
 }
 
-CliRun run_cli(const std::string& args) {
-    const fs::path out = temp_dir() / "stdout.txt", err = temp_dir() / "stderr.txt";
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" + out.string() +
-                            " 2>" + err.string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
+CliRun run_cli(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
 
 TEST(KdTreePartitionCli, WritesBoxesJsonAndOverlayPng) {
     const fs::path vol = temp_dir() / "tree.nrrd", json = temp_dir() / "boxes.json",

@@ -1,7 +1,8 @@
 // The CLI end to end: good runs produce files and timing lines; every bad input gives one line
 // naming the file and the problem, exit code 2, and leaves no output file behind.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+
+#include "apps/cli_run.h"
 
 #include <filesystem>
 #include <fstream>
@@ -12,47 +13,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
+using CliRun = lacuna::test::CliResult;
+using lacuna::test::expect_one_line_error;
+std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
 
 fs::path temp_dir() {
-    static fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() /
-                     ("lacuna-cli-" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = lacuna::test::cli_temp_dir("cli");
     return dir;
 }
 
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
-CliRun run(const std::string& args) {
-    const fs::path out = temp_dir() / "stdout.txt", err = temp_dir() / "stderr.txt";
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" + out.string() +
-                            " 2>" + err.string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    CliRun r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
-
-// One line, mentioning `needle`, exit code 2.
-void expect_one_line_error(const CliRun& r, const std::string& needle) {
-    EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
-    ASSERT_FALSE(r.err.empty());
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than one line: " << r.err;
-}
+CliRun run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
 
 const fs::path& small_volume() {
     static fs::path p = [] {

@@ -1,48 +1,27 @@
 // `lacuna partition --method boxes` end to end: stats lines, JSON, the Figure 2 picture, and one
 // line with exit code 2 (nothing written) for bad options.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
+
+#include "apps/cli_run.h"
 
 namespace lacuna {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+using CliRun = lacuna::test::CliResult;
+std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
 
 fs::path temp_dir() {
-    static fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("lacuna-boxes-" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = lacuna::test::cli_temp_dir("boxes");
     return dir;
 }
 
-CliRun run_cli(const std::string& args) {
-    const fs::path out = temp_dir() / "stdout.txt", err = temp_dir() / "stderr.txt";
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" + out.string() +
-                            " 2>" + err.string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
+CliRun run_cli(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
 
 const fs::path& volume() {
     static fs::path v = [] {
