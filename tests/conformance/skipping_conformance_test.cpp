@@ -13,6 +13,7 @@
 #include <random>
 
 #include "common/rng.h"
+#include "conformance/conformance_util.h"
 #include "lacuna/accel.h"
 #include "lacuna/io.h"
 #include "lacuna/renderer.h"
@@ -23,6 +24,9 @@ namespace lacuna {
 namespace {
 
 using test::Rng;
+using test::random_camera;
+using test::random_lut;
+using test::spike_lut;
 
 struct Case {
     std::string name;
@@ -54,48 +58,6 @@ void expect_all_structures_exact(const Case& c, std::vector<AccelKind> kinds = a
             << c.name << " accel " << to_string(k) << ": float accumulations differ";
         ASSERT_LE(r.stats.samples, ref.stats.samples) << c.name << " accel " << to_string(k);
     }
-}
-
-// A LUT that is transparent except for one entry (the sharpest test of a structure).
-TransferLut spike_lut(ValueRange vis, int entry, float opacity = 0.7f) {
-    TransferLut lut;
-    lut.vis = vis;
-    lut.entries.assign(kDefaultLutSize, Rgba{});
-    lut.entries[size_t(entry)] = {0.9f, 0.6f, 0.3f, opacity};
-    return lut;
-}
-
-// A random piecewise TF: a few random opacity bumps with zero between them.
-TransferLut random_lut(ValueRange vis, Rng& rng) {
-    TransferLut lut;
-    lut.vis = vis;
-    lut.entries.assign(kDefaultLutSize, Rgba{});
-    const int bumps = rng.range(1, 4);
-    for (int b = 0; b < bumps; ++b) {
-        const int c = rng.range(0, kDefaultLutSize - 1), w = rng.range(0, 40);
-        const float a = 0.05f + 0.9f * rng.uniform();
-        for (int e = std::max(0, c - w); e <= std::min(kDefaultLutSize - 1, c + w); ++e)
-            lut.entries[size_t(e)] = {rng.uniform(), rng.uniform(), rng.uniform(), a};
-    }
-    return lut;
-}
-
-Camera random_camera(const Volume& v, Rng& rng, int size) {
-    OrbitParams p;
-    p.azimuth_deg = 360.f * rng.uniform();
-    p.elevation_deg = -80.f + 160.f * rng.uniform();
-    p.projection = rng.range(0, 3) == 0 ? Projection::Orthographic : Projection::Perspective;
-    const Box3f b{{0, 0, 0}, v.world_extent()};
-    if (p.projection == Projection::Perspective && rng.range(0, 2) == 0) {
-        // Inside the volume: a target in the box and a short distance.
-        p.has_target = true;
-        p.target = {b.hi.x * rng.uniform(), b.hi.y * rng.uniform(), b.hi.z * rng.uniform()};
-        p.distance = 0.05f + 0.3f * length(b.extent()) * rng.uniform();
-        p.fov_y_deg = 40.f + 60.f * rng.uniform();
-    } else {
-        p.zoom = 0.7f + 2.f * rng.uniform();
-    }
-    return Camera::orbit(b, p, size, size);
 }
 
 TEST(Conformance, AdversarialSyntheticVolumesAreExactForEveryStructure) {
