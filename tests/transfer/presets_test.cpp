@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
+#include "transfer/transfer_test_util.h"
 
 namespace lacuna {
 namespace {
@@ -16,21 +16,8 @@ double entry_t(int e, int size) {
     return double(e) / double(size - 1);
 }
 
-std::string error_message(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no lacuna::Error thrown)";
-}
-
-std::string temp_path(const std::string& file) {
-    const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-    return (std::filesystem::path(testing::TempDir()) /
-            (std::string("lacuna_") + info->name() + "_" + file))
-        .string();
-}
+using test::error_message;
+using test::temp_path;
 
 TEST(Presets, ListsAllRequiredNames) {
     const std::vector<std::string> names = preset_names();

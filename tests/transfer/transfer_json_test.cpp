@@ -5,30 +5,17 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <random>
 
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
+#include "transfer/transfer_test_util.h"
 
 namespace lacuna {
 namespace {
 
-std::string error_message(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no lacuna::Error thrown)";
-}
-
-std::string temp_path(const std::string& file) {
-    const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-    return (std::filesystem::path(testing::TempDir()) /
-            (std::string("lacuna_") + info->name() + "_" + file))
-        .string();
-}
+using test::error_message;
+using test::temp_path;
 
 TEST(TransferJson, RoundTripsEveryPreset) {
     for (const std::string& name : preset_names()) {
