@@ -11,7 +11,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -153,20 +152,6 @@ constexpr Rgb kPalette[] = {{255, 64, 64},  {64, 220, 64},  {80, 140, 255}, {255
                             {255, 80, 255}, {40, 230, 230}, {255, 150, 40}, {180, 120, 255}};
 
 // ---- JSON ------------------------------------------------------------------------------------
-
-void write_text_atomic(const std::string& path, const std::string& text) {
-    const io::TempName tmp = io::temp_name_beside(path);
-    {
-        std::ofstream f(tmp.path, std::ios::binary);
-        f << text;
-        f.flush();
-        if (!f) {
-            io::remove_temp_files(tmp);
-            throw Error(path, "output", "cannot write the file");
-        }
-    }
-    io::rename_over(tmp.path, path);
-}
 
 nlohmann::json box_json(const CellBox& b, uint64_t non_empty) {
     // Cells [lo, hi) are voxels lo..hi (index coordinates of the box's corners).
@@ -329,7 +314,7 @@ void run(const PartitionArgs& a) {
             list.push_back(box_json(b, ne));
         }
         j["boxes"] = list;
-        write_text_atomic(a.json, j.dump(2) + "\n");
+        io::write_text_atomic(a.json, j.dump(2) + "\n");
         std::printf("wrote %s\n", a.json.c_str());
     }
 

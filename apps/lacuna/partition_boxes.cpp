@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "core/parallel.h"
@@ -17,20 +16,6 @@
 namespace lacuna::cli {
 
 namespace {
-
-void write_text_atomic(const std::string& path, const std::string& text) {
-    const io::TempName tmp = io::temp_name_beside(path);
-    {
-        std::ofstream f(tmp.path, std::ios::binary);
-        f << text;
-        f.flush();
-        if (!f) {
-            io::remove_temp_files(tmp);
-            throw Error(path, "output", "cannot write the file");
-        }
-    }
-    io::rename_over(tmp.path, path);
-}
 
 double ms(double s) {
     return std::round(s * 1e6) / 1e3;
@@ -261,7 +246,7 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
             list.push_back(e);
         }
         j["boxes"] = list;
-        write_text_atomic(a.json, j.dump(1) + "\n");
+        io::write_text_atomic(a.json, j.dump(1) + "\n");
         std::printf("wrote %s\n", a.json.c_str());
     }
     if (!a.out.empty()) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <system_error>
 #include <vector>
@@ -108,6 +109,20 @@ void rename_over(const std::string& from, const std::string& to) {
     if (std::rename(from.c_str(), to.c_str()) != 0)
         throw Error(to, "output",
                     std::string("cannot write: rename failed: ") + std::strerror(errno));
+}
+
+void write_text_atomic(const std::string& path, const std::string& text) {
+    const TempName tmp = temp_name_beside(path);
+    {
+        std::ofstream f(tmp.path, std::ios::binary);
+        f << text;
+        f.flush();
+        if (!f) {
+            remove_temp_files(tmp);
+            throw Error(path, "output", "cannot write the file");
+        }
+    }
+    rename_over(tmp.path, path);
 }
 
 size_t disk_type_size(DiskType t) {

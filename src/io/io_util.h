@@ -38,6 +38,10 @@ TempName temp_name_beside(const std::string& path);
 void remove_temp_files(const TempName& t) noexcept;
 // Renames `from` over `to`; throws Error(to, "output", ...) on failure.
 void rename_over(const std::string& from, const std::string& to);
+// Writes `text` to `path` atomically: a temporary file beside it (temp_name_beside), then
+// rename_over. On a failed write the temporary file is removed and Error(path, "output", ...)
+// is thrown, so nothing is left half-written.
+void write_text_atomic(const std::string& path, const std::string& text);
 
 // Calls progress(f) if set; exceptions from the callback propagate.
 inline void report(const std::function<void(double)>& progress, double f) {
