@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bench/report.h"
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "render/sample_analysis.h"
@@ -15,12 +16,6 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-std::string fmt(const char* f, double a) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, a);
-    return buf;
 }
 
 RenderOptions render_options(const FaludiOptions& o, RowMode m, const Box3f& bounds) {

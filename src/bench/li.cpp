@@ -16,12 +16,6 @@ namespace lacuna::bench {
 
 namespace {
 
-std::string fmt(const char* f, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, v);
-    return buf;
-}
-
 double fps(const LiColumn* c) { return c && c->mean_ms > 0 ? 1e3 / c->mean_ms : 0; }
 double ratio(const LiColumn* a, const LiColumn* b) {
     return a && b && b->mean_ms > 0 ? a->mean_ms / b->mean_ms : 0;

@@ -13,12 +13,6 @@ namespace lacuna::bench {
 
 namespace {
 
-std::string fmt(const char* f, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, v);
-    return buf;
-}
-
 std::string trim(std::string s) {
     while (!s.empty() && (s.back() == '\n' || s.back() == ' ' || s.back() == '\t')) s.pop_back();
     size_t b = 0;
@@ -319,6 +313,12 @@ std::string faludi_csv(const FaludiReport& rep) {
                 out << buf;
             }
     return out.str();
+}
+
+std::string fmt(const char* format, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, v);
+    return buf;
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

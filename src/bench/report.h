@@ -29,6 +29,10 @@ std::string faludi_markdown(const FaludiReport& report, const RunInfo& info);
 // One line per dataset x row x structure, every number (header in the first line).
 std::string faludi_csv(const FaludiReport& report);
 
+// One number formatted with a printf format of one double conversion ("%.2f", "%.1f%%"); the
+// result is cut at 63 characters. Every bench report formats its numbers through this.
+std::string fmt(const char* format, double v);
+
 // Writes text atomically (temporary file + rename). Throws lacuna::Error(path, "output", ...).
 void write_text_file(const std::string& path, const std::string& text);
 

@@ -16,12 +16,6 @@ namespace lacuna::bench {
 
 namespace {
 
-std::string fmt(const char* f, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, v);
-    return buf;
-}
-
 int octree_levels(const Volume& v, int leaf) {
     int cells[3];
     cell_counts(v, cells);
