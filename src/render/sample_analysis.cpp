@@ -41,25 +41,45 @@ VisibleCells::VisibleCells(const Volume& v, const TransferLut& lut, int threads)
 
 namespace {
 
+// The reference's ray through pixel (x, y), set up as ray_marcher.cpp does: in index space
+// (inv_sp = 1 / spacing per axis) and clipped to the grid box [0, hi]. False on a miss; else the
+// lattice t_k = t_near + (k + 0.5) * dt holds k_end samples of the ray.
+struct PixelRay {
+    kernel::IndexRay r;
+    float t_near, t_far;
+    int k_end;
+};
+bool pixel_ray(const Camera& cam, const Vec3f& inv_sp, const float hi[3], float dt, int x, int y,
+               PixelRay& p) {
+    const Ray wr = cam.generate(float(x), float(y));
+    const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
+    p.r = kernel::IndexRay{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+    if (!kernel::intersect_box(p.r, hi, p.t_near, p.t_far)) return false;
+    p.k_end = std::max(int(std::ceil((p.t_far - p.t_near) / dt - 0.5f)), 0);
+    return true;
+}
+
+Vec3f inverse_spacing(const Volume& vol) {
+    return {float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y), float(1.0 / vol.spacing.z)};
+}
+
 // Visible-cell samples of the pixels [x0,x1) x [y0,y1).
 template <class T>
 uint64_t count_tile(const kernel::Grid<T, int64_t>& g, const VisibleCells& cells, const Volume& vol,
                     const Camera& cam, const std::vector<Rgba>& lut, ValueToLut map, float dt,
                     float ert, int x0, int y0, int x1, int y1) {
-    const Vec3f inv_sp{float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y),
-                       float(1.0 / vol.spacing.z)};
+    const Vec3f inv_sp = inverse_spacing(vol);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     const bool use_ert = ert < 1.f;
     uint64_t n = 0;
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
             // 1. The reference's ray, in index space, clipped to the box.
-            const Ray wr = cam.generate(float(x), float(y));
-            const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
-            const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
-            float t_near, t_far;
-            if (!kernel::intersect_box(r, hi, t_near, t_far)) continue;
-            const int k_end = std::max(int(std::ceil((t_far - t_near) / dt - 0.5f)), 0);
+            PixelRay p;
+            if (!pixel_ray(cam, inv_sp, hi, dt, x, y, p)) continue;
+            const kernel::IndexRay& r = p.r;
+            const float t_near = p.t_near;
+            const int k_end = p.k_end;
             kernel::Accum acc;
             for (int s = 0; s < k_end; ++s) {
                 // 2. The lattice position and its cell, computed as kernel::march does.
@@ -117,6 +137,25 @@ uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut, c
                                     const RenderOptions& opt) {
     const VisibleCells cells(vol, lut, opt.threads);
     return count_visible_cell_samples(vol, lut, cells, cam, opt);
+}
+
+uint64_t count_lattice_samples(const Volume& vol, const Camera& cam, float step, int threads) {
+    const Vec3i d = vol.dims();
+    const Vec3f inv_sp = inverse_spacing(vol);
+    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
+    const float dt = step * min_sp;
+    const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
+    std::atomic<uint64_t> total{0};
+    parallel_for_tiles(cam.width(), cam.height(), 32, threads, [&](int x0, int y0, int x1, int y1) {
+        uint64_t n = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                PixelRay p;
+                if (pixel_ray(cam, inv_sp, hi, dt, x, y, p)) n += uint64_t(p.k_end);
+            }
+        total += n;
+    });
+    return total.load();
 }
 
 }  // namespace lacuna

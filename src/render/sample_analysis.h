@@ -67,4 +67,10 @@ uint64_t count_visible_cell_samples(const Volume& volume, const TransferLut& lut
 uint64_t count_visible_cell_samples(const Volume& volume, const TransferLut& lut,
                                     const Camera& camera, const RenderOptions& options);
 
+// Lattice samples of the reference march (no skipping, no early ray termination) summed over
+// every pixel of `camera`: the same ray set-up and count as ray_marcher.cpp, without touching
+// the voxels. `step` is in units of the smallest spacing (RenderOptions::step).
+uint64_t count_lattice_samples(const Volume& volume, const Camera& camera, float step,
+                               int threads = 0);
+
 }  // namespace lacuna

@@ -1,12 +1,11 @@
 #include "serve/frame_renderer.h"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <mutex>
 
 #include "core/parallel.h"
-#include "render/ray_march_kernel.h"
+#include "render/sample_analysis.h"
 #include "slice/box_sources.h"
 
 namespace lacuna::serve {
@@ -42,30 +41,13 @@ std::vector<uint64_t> compute_histogram(const Volume& v, int bins, int threads) 
     return total;
 }
 
-// Lattice samples of the reference march (no skipping, no early termination) for every pixel:
-// the same ray set-up and count as render/ray_marcher.cpp, without touching the volume.
-uint64_t lattice_samples(const Volume& vol, const Camera& cam, float step, int threads) {
-    const Vec3i d = vol.dims();
-    const Vec3f inv_sp{float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y),
-                       float(1.0 / vol.spacing.z)};
-    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
-    const float dt = step * min_sp;
-    const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
-    std::atomic<uint64_t> total{0};
-    parallel_for_tiles(cam.width(), cam.height(), 32, threads, [&](int x0, int y0, int x1, int y1) {
-        uint64_t n = 0;
-        for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x) {
-                const Ray wr = cam.generate(float(x), float(y));
-                const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
-                const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
-                float t0, t1;
-                if (kernel::intersect_box(r, hi, t0, t1))
-                    n += uint64_t(std::max(int(std::ceil((t1 - t0) / dt - 0.5f)), 0));
-            }
-        total += n;
-    });
-    return total.load();
+// A structure, box source or segment renderer that missed TF changes (it was not selected
+// then) catches up: `held` is the TF version it holds, `version` the current one.
+template <class T>
+void catch_up_tf(T& target, uint64_t& held, const TransferLut& lut, uint64_t version) {
+    if (held == version) return;
+    target.set_transfer_function(lut);
+    held = version;
 }
 
 }  // namespace
@@ -151,10 +133,7 @@ Frame FrameRenderer::render_slice(const ViewRequest& req, int width, int height)
                                    m_accel_options);
         f.accel_build_seconds = seconds_since(tb);
     }
-    if (b.tf_version != m_tf_version) {
-        b.source->set_transfer_function(m_lut);
-        b.tf_version = m_tf_version;
-    }
+    catch_up_tf(*b.source, b.tf_version, m_lut, m_tf_version);
     if (f.tf_changed) f.tf_update_seconds = seconds_since(t0);
     m_slicer->set_box_source(b.source.get());
     const Camera cam = camera(req.camera, width, height);
@@ -168,7 +147,7 @@ Frame FrameRenderer::render_slice(const ViewRequest& req, int width, int height)
     f.stats.samples = r.stats.samples;
     f.stats.pixels = uint64_t(width) * uint64_t(height);
     f.stats.rays = f.stats.pixels;  // the slicer has no rays: samples per pixel
-    f.lattice_samples = lattice_samples(*m_volume, cam, req.step, m_threads);
+    f.lattice_samples = count_lattice_samples(*m_volume, cam, req.step, m_threads);
     f.skipped = f.lattice_samples && f.stats.samples < f.lattice_samples
                     ? 1.0 - double(f.stats.samples) / double(f.lattice_samples)
                     : 0.0;
@@ -197,19 +176,12 @@ Frame FrameRenderer::render_segments(const ViewRequest& req, int width, int heig
         b.renderer = std::make_unique<SegmentRenderer>(m_volume.get(), *m_labels, so);
         f.accel_build_seconds = seconds_since(tb);
     }
-    if (b.tf_version != m_tf_version) {
-        b.renderer->set_transfer_function(m_lut);
-        b.tf_version = m_tf_version;
-    }
+    catch_up_tf(*b.renderer, b.tf_version, m_lut, m_tf_version);
     if (!octree) {
         const Accel* a = nullptr;
         if (req.accel != AccelKind::None) {
             Accel& acc = accel(req.accel, f.accel_build_seconds);
-            Built& built = m_accels[req.accel];
-            if (built.tf_version != m_tf_version) {
-                acc.set_transfer_function(m_lut);
-                built.tf_version = m_tf_version;
-            }
+            catch_up_tf(acc, m_accels[req.accel].tf_version, m_lut, m_tf_version);
             a = &acc;
         }
         b.renderer->set_accel(a);
@@ -223,7 +195,7 @@ Frame FrameRenderer::render_segments(const ViewRequest& req, int width, int heig
     RenderResult r = b.renderer->render(cam, ro);
     f.image = std::move(r.image);
     f.stats = r.stats;
-    f.lattice_samples = lattice_samples(*m_volume, cam, ro.step, m_threads);
+    f.lattice_samples = count_lattice_samples(*m_volume, cam, ro.step, m_threads);
     f.skipped = f.lattice_samples ? 1.0 - double(f.stats.samples) / double(f.lattice_samples) : 0.0;
     return f;
 }
@@ -239,10 +211,7 @@ Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     const auto t0 = Clock::now();
     f.tf_changed = update_tf(req.tf);
     // 2. A structure that missed TF changes (it was not selected then) catches up.
-    if (built.tf_version != m_tf_version) {
-        a.set_transfer_function(m_lut);
-        built.tf_version = m_tf_version;
-    }
+    catch_up_tf(a, built.tf_version, m_lut, m_tf_version);
     if (f.tf_changed) f.tf_update_seconds = seconds_since(t0);
     f.accel_tf_update_seconds = a.stats().tf_update_seconds;
     m_marcher->set_accel(&a);
@@ -253,7 +222,7 @@ Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     RenderResult r = m_marcher->render(cam, ro);
     f.image = std::move(r.image);
     f.stats = r.stats;
-    f.lattice_samples = lattice_samples(*m_volume, cam, ro.step, m_threads);
+    f.lattice_samples = count_lattice_samples(*m_volume, cam, ro.step, m_threads);
     f.skipped = f.lattice_samples ? 1.0 - double(f.stats.samples) / double(f.lattice_samples) : 0.0;
     return f;
 }
