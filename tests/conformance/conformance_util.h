@@ -1,6 +1,6 @@
-// Random volumes, TFs and cameras for the conformance suites (the same recipes as
-// skipping_conformance_test.cpp: sparse random voxels, single-entry opacity spikes, cameras
-// inside and outside the volume).
+// Random volumes, TFs and cameras for the conformance suites (skipping_conformance_test.cpp,
+// feature_conformance_test.cpp) and the render tests: sparse random voxels, single-entry opacity
+// spikes, cameras inside and outside the volume.
 #pragma once
 #include <algorithm>
 #include <cmath>
