@@ -27,6 +27,7 @@
 #include <cstdint>
 
 #include "accel/cursor.h"
+#include "render/pixel_driver.h"
 #include "accel/entry_window.h"
 #include "accel/no_accel.h"
 #include "core/parallel.h"
@@ -99,22 +100,6 @@ inline float jitter(uint32_t x, uint32_t y, uint32_t seed) {
     h *= 0x846ca68bu;
     h ^= h >> 16;
     return float(h >> 8) * (1.f / 16777216.f);
-}
-
-// Calls fn(k) for the lattice samples t_k = t_base + (k + 0.5)*dt, k < k_end, that lie in the
-// cursor's segments (rounded outward, as the fast kernel does), in order, each at most once,
-// until fn returns false.
-template <class Cursor, class Fn>
-inline void for_each_sample(Cursor& cursor, float t_base, float dt, int k_end, Fn&& fn) {
-    Segment seg;
-    int k = 0;
-    bool go = true;
-    while (go && k < k_end && cursor.next(seg)) {
-        const int kb = std::max(k, int(std::floor((seg.t0 - t_base) / dt - 0.5f)));
-        const int ke = std::min(k_end, int(std::floor((seg.t1 - t_base) / dt - 0.5f)) + 2);
-        for (int j = kb; j < ke && go; ++j) go = fn(j);
-        k = std::max(k, ke);
-    }
 }
 
 // World-space gradient (voxel values per mm) at index point (x,y,z).
@@ -363,12 +348,11 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                  RenderResult& out, Counts& counts) {
     const FeatureOptions& f = *c.f;
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
-    const float chunk = 16.f * c.dt;
+    const float chunk = kCursorChunk * c.dt;
     for (int py = y0; py < y1; ++py) {
         for (int px = x0; px < x1; ++px) {
             const Ray wr = cam.generate(float(px), float(py));
-            const Vec3f o = wr.origin * c.inv_sp, dir = wr.dir * c.inv_sp;
-            const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+            const kernel::IndexRay r = index_ray(wr, c.inv_sp);
             const Vec3f view = -wr.dir;
             kernel::Accum acc;
             uint32_t n = 0;
@@ -377,8 +361,8 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                 ++counts.rays;
                 const float j = f.jitter ? jitter(uint32_t(px), uint32_t(py), f.jitter_seed) : 0.5f;
                 const float t_base = t_near + (j - 0.5f) * c.dt;
-                const int k_end = std::max(int(std::ceil((t_far - t_base) / c.dt - 0.5f)), 0);
-                const CursorRay cr{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}};
+                const int k_end = lattice_end(t_base, t_far, c.dt);
+                const CursorRay cr = cursor_ray(r);
                 if (f.blend == BlendMode::Mip || f.blend == BlendMode::MinIp) {
                     const bool maximum = f.blend == BlendMode::Mip;
                     int lo = 0, hi_e = c.map.last();
@@ -406,18 +390,7 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                 }
             }
             counts.samples += n;
-            const float w = 1.f - acc.a;
-            uint8_t* p = out.image.pixel(px, py);
-            const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
-                                  acc.b + w * opt.background.z};
-            for (int ch = 0; ch < 3; ++ch)
-                p[ch] = uint8_t(std::lround(std::clamp(rgb[ch], 0.f, 1.f) * 255.f));
-            p[3] = 255;
-            if (opt.keep_float) {
-                float* fl = &out.rgba_float[(size_t(py) * size_t(out.image.width) + px) * 4];
-                fl[0] = acc.r, fl[1] = acc.g, fl[2] = acc.b, fl[3] = acc.a;
-            }
-            if (opt.count_samples) out.sample_counts[size_t(py) * size_t(out.image.width) + px] = n;
+            write_pixel(out, opt, px, py, acc, n);
         }
     }
 }

@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "lacuna/error.h"
 #include "render/marcher_cache.h"
+#include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 
 namespace lacuna {
@@ -86,10 +87,6 @@ Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; 
 
 namespace {
 
-// With early ray termination the cursor hands out occupied stretches of at most about this many
-// samples, so a ray that turns opaque early does not walk the structure to its far end.
-constexpr float kChunk = 16.f;
-
 template <class T, class Index, class S>
 void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
                  const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
@@ -112,46 +109,24 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
     uint64_t tile_samples = 0, tile_rays = 0;
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
-            const Ray wr = cam.generate(float(x), float(y));
-            const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
-            const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+            const kernel::IndexRay r = index_ray(cam.generate(float(x), float(y)), inv_sp);
             kernel::Accum acc;
             uint32_t n = 0;
             float t_near, t_far;
             if (kernel::intersect_box(r, hi, t_near, t_far)) {
                 ++tile_rays;
-                // Number of lattice samples with t_k < t_far.
-                const int k_end = std::max(int(std::ceil((t_far - t_near) / dt - 0.5f)), 0);
-                // The structure's stretches, rounded outward to lattice samples: a few extra
-                // reference samples may be taken, a visible one is never missed.
-                typename S::Cursor cursor(accel, CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}},
-                                          t_near, t_far, dt, opt.ert < 1.f ? kChunk * dt : 0.f);
-                Segment seg;
+                typename S::Cursor cursor(accel, cursor_ray(r), t_near, t_far, dt,
+                                          opt.ert < 1.f ? kCursorChunk * dt : 0.f);
                 bool done = false;
-                int k = 0;
-                while (!done && k < k_end && cursor.next(seg)) {
-                    const int kb = std::max(k, int(std::floor((seg.t0 - t_near) / dt - 0.5f)));
-                    const int ke =
-                        std::min(k_end, int(std::floor((seg.t1 - t_near) / dt - 0.5f)) + 2);
-                    if (ke > kb)
-                        n += kernel::march(g, r, t_near, dt, kb, ke, lut.data(), map, opt.ert,
-                                           acc, done);
-                    k = std::max(k, ke);
-                }
+                for_each_lattice_run(cursor, t_near, dt, lattice_end(t_near, t_far, dt),
+                                     [&](int kb, int ke) {
+                                         n += kernel::march(g, r, t_near, dt, kb, ke, lut.data(),
+                                                            map, opt.ert, acc, done);
+                                         return !done;
+                                     });
             }
             tile_samples += n;
-            const float w = 1.f - acc.a;
-            uint8_t* px = out.image.pixel(x, y);
-            const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
-                                  acc.b + w * opt.background.z};
-            for (int c = 0; c < 3; ++c)
-                px[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
-            px[3] = 255;
-            if (opt.keep_float) {
-                float* f = &out.rgba_float[(size_t(y) * size_t(out.image.width) + x) * 4];
-                f[0] = acc.r, f[1] = acc.g, f[2] = acc.b, f[3] = acc.a;
-            }
-            if (opt.count_samples) out.sample_counts[size_t(y) * size_t(out.image.width) + x] = n;
+            write_pixel(out, opt, x, y, acc, n);
         }
     }
     samples += tile_samples;

@@ -17,6 +17,7 @@
 #include "core/parallel.h"
 #include "lacuna/error.h"
 #include "lacuna/segments.h"
+#include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 
 namespace lacuna {
@@ -36,7 +37,6 @@ struct SegmentRenderer::Impl {
 
 namespace {
 
-constexpr float kChunk = 16.f;  // as in the ray marcher: stretches under early termination
 
 template <class L>
 struct LabelGrid {
@@ -84,73 +84,49 @@ void render_tile(const S& accel, const Volume& geom, const T* data, const L* lab
     uint64_t tile_samples = 0, tile_rays = 0;
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
-            const Ray wr = f.cam.generate(float(x), float(y));
-            const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
-            const kernel::IndexRay r{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+            const kernel::IndexRay r = index_ray(f.cam.generate(float(x), float(y)), inv_sp);
             kernel::Accum acc;
             uint32_t n = 0;
             float t_near, t_far;
             if (kernel::intersect_box(r, hi, t_near, t_far)) {
                 ++tile_rays;
-                const int k_end = std::max(int(std::ceil((t_far - t_near) / dt - 0.5f)), 0);
-                typename S::Cursor cursor(accel, CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}},
-                                          t_near, t_far, dt, ert < 1.f ? kChunk * dt : 0.f);
-                Segment seg;
-                bool done = false;
-                int k = 0;
-                while (!done && k < k_end && cursor.next(seg)) {
-                    const int kb = std::max(k, int(std::floor((seg.t0 - t_near) / dt - 0.5f)));
-                    const int ke =
-                        std::min(k_end, int(std::floor((seg.t1 - t_near) / dt - 0.5f)) + 2);
-                    for (int s = kb; s < ke && !done; ++s) {
-                        // The ray marcher's lattice and clamping (ray_march_kernel.h).
-                        const float t = t_near + (float(s) + 0.5f) * dt;
-                        float px = r.ox + t * r.dx, py = r.oy + t * r.dy, pz = r.oz + t * r.dz;
-                        px = px < 0.f ? 0.f : (px > g.hi_x ? g.hi_x : px);
-                        py = py < 0.f ? 0.f : (py > g.hi_y ? g.hi_y : py);
-                        pz = pz < 0.f ? 0.f : (pz > g.hi_z ? g.hi_z : pz);
-                        ++n;
-                        const int l = int(lg.at(px, py, pz));
-                        if (l >= f.table_size) continue;  // no style: unseen
-                        const Rgba& ls = f.table[l];
-                        if (ls.a == 0.f) continue;
-                        Rgba c;
-                        if (f.masked) {
-                            const Rgba& tc = f.lut[f.map(kernel::trilinear(g, px, py, pz))];
-                            // Premultiplied: the TF colour mixed with the label's, then the
-                            // label's opacity factor.
-                            const float keep = 1.f - f.tint;
-                            c.r = (keep * tc.r + f.tint * ls.r * tc.a) * ls.a;
-                            c.g = (keep * tc.g + f.tint * ls.g * tc.a) * ls.a;
-                            c.b = (keep * tc.b + f.tint * ls.b * tc.a) * ls.a;
-                            c.a = tc.a * ls.a;
-                        } else {
-                            c = ls;
-                        }
-                        const float w = 1.f - acc.a;
-                        acc.r += w * c.r;
-                        acc.g += w * c.g;
-                        acc.b += w * c.b;
-                        acc.a += w * c.a;
-                        if (acc.a >= ert) done = true;
+                typename S::Cursor cursor(accel, cursor_ray(r), t_near, t_far, dt,
+                                          ert < 1.f ? kCursorChunk * dt : 0.f);
+                for_each_sample(cursor, t_near, dt, lattice_end(t_near, t_far, dt), [&](int s) {
+                    // The ray marcher's lattice and clamping (ray_march_kernel.h).
+                    const float t = t_near + (float(s) + 0.5f) * dt;
+                    float px = r.ox + t * r.dx, py = r.oy + t * r.dy, pz = r.oz + t * r.dz;
+                    px = px < 0.f ? 0.f : (px > g.hi_x ? g.hi_x : px);
+                    py = py < 0.f ? 0.f : (py > g.hi_y ? g.hi_y : py);
+                    pz = pz < 0.f ? 0.f : (pz > g.hi_z ? g.hi_z : pz);
+                    ++n;
+                    const int l = int(lg.at(px, py, pz));
+                    if (l >= f.table_size) return true;  // no style: unseen
+                    const Rgba& ls = f.table[l];
+                    if (ls.a == 0.f) return true;
+                    Rgba c;
+                    if (f.masked) {
+                        const Rgba& tc = f.lut[f.map(kernel::trilinear(g, px, py, pz))];
+                        // Premultiplied: the TF colour mixed with the label's, then the
+                        // label's opacity factor.
+                        const float keep = 1.f - f.tint;
+                        c.r = (keep * tc.r + f.tint * ls.r * tc.a) * ls.a;
+                        c.g = (keep * tc.g + f.tint * ls.g * tc.a) * ls.a;
+                        c.b = (keep * tc.b + f.tint * ls.b * tc.a) * ls.a;
+                        c.a = tc.a * ls.a;
+                    } else {
+                        c = ls;
                     }
-                    k = std::max(k, ke);
-                }
+                    const float w = 1.f - acc.a;
+                    acc.r += w * c.r;
+                    acc.g += w * c.g;
+                    acc.b += w * c.b;
+                    acc.a += w * c.a;
+                    return acc.a < ert;  // early ray termination
+                });
             }
             tile_samples += n;
-            const float w = 1.f - acc.a;
-            uint8_t* px = f.out.image.pixel(x, y);
-            const float rgb[3] = {acc.r + w * f.opt.background.x, acc.g + w * f.opt.background.y,
-                                  acc.b + w * f.opt.background.z};
-            for (int c = 0; c < 3; ++c)
-                px[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
-            px[3] = 255;
-            const size_t p = size_t(y) * size_t(f.out.image.width) + size_t(x);
-            if (f.opt.keep_float) {
-                float* fl = &f.out.rgba_float[p * 4];
-                fl[0] = acc.r, fl[1] = acc.g, fl[2] = acc.b, fl[3] = acc.a;
-            }
-            if (f.opt.count_samples) f.out.sample_counts[p] = n;
+            write_pixel(f.out, f.opt, x, y, acc, n);
         }
     }
     f.samples += tile_samples;

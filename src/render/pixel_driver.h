@@ -1,0 +1,80 @@
+// What every per-pixel ray loop of the renderers shares (the ray marcher, the feature path and
+// the segment renderer): the pixel's ray in index space, the cursor's stretches rounded outward
+// to the reference lattice, and the pixel write-out. One copy, so the three paths cannot drift
+// apart in the arithmetic that makes them byte-identical to each other.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "accel/cursor.h"
+#include "lacuna/camera.h"
+#include "lacuna/renderer.h"
+#include "render/ray_march_kernel.h"
+
+namespace lacuna {
+
+// With early ray termination the cursor hands out occupied stretches of at most about this many
+// samples, so a ray that turns opaque early does not walk the structure to its far end.
+constexpr float kCursorChunk = 16.f;
+
+// Pixel (x, y)'s camera ray moved into index space (t stays in world units).
+inline kernel::IndexRay index_ray(const Ray& wr, Vec3f inv_sp) {
+    const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
+    return kernel::IndexRay{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+}
+
+inline CursorRay cursor_ray(const kernel::IndexRay& r) {
+    return CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}};
+}
+
+// Number of lattice samples t_k = t_base + (k + 0.5)*dt with t_k < t_far.
+inline int lattice_end(float t_base, float t_far, float dt) {
+    return std::max(int(std::ceil((t_far - t_base) / dt - 0.5f)), 0);
+}
+
+// Calls fn(kb, ke) for the runs [kb, ke) of lattice samples t_k = t_base + (k + 0.5)*dt, k <
+// k_end, that lie in the cursor's segments, rounded outward (a few extra reference samples may
+// be taken, a visible one is never missed), in order and disjoint, until fn returns false.
+template <class Cursor, class Fn>
+inline void for_each_lattice_run(Cursor& cursor, float t_base, float dt, int k_end, Fn&& fn) {
+    Segment seg;
+    int k = 0;
+    bool go = true;
+    while (go && k < k_end && cursor.next(seg)) {
+        const int kb = std::max(k, int(std::floor((seg.t0 - t_base) / dt - 0.5f)));
+        const int ke = std::min(k_end, int(std::floor((seg.t1 - t_base) / dt - 0.5f)) + 2);
+        if (ke > kb) go = fn(kb, ke);
+        k = std::max(k, ke);
+    }
+}
+
+// The same, one sample at a time: fn(k) returns false to stop.
+template <class Cursor, class Fn>
+inline void for_each_sample(Cursor& cursor, float t_base, float dt, int k_end, Fn&& fn) {
+    for_each_lattice_run(cursor, t_base, dt, k_end, [&](int kb, int ke) {
+        for (int j = kb; j < ke; ++j)
+            if (!fn(j)) return false;
+        return true;
+    });
+}
+
+// Composites the background behind `acc` and writes pixel (x, y) of `out`: RGBA8, and the float
+// RGBA and the sample count when the options ask for them.
+inline void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
+                        const kernel::Accum& acc, uint32_t samples) {
+    const float w = 1.f - acc.a;
+    uint8_t* px = out.image.pixel(x, y);
+    const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
+                          acc.b + w * opt.background.z};
+    for (int c = 0; c < 3; ++c) px[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
+    px[3] = 255;
+    const size_t p = size_t(y) * size_t(out.image.width) + size_t(x);
+    if (opt.keep_float) {
+        float* f = &out.rgba_float[p * 4];
+        f[0] = acc.r, f[1] = acc.g, f[2] = acc.b, f[3] = acc.a;
+    }
+    if (opt.count_samples) out.sample_counts[p] = samples;
+}
+
+}  // namespace lacuna
