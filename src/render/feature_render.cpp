@@ -179,9 +179,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
     visit_voxels(m_volume, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
         // The feature path always indexes with int64 (it is not the hot path for huge grids).
-        const kernel::Grid<T, int64_t> g{data, ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
-                                         float(d.x - 1), float(d.y - 1), float(d.z - 1),
-                                         d.x - 2, d.y - 2, d.z - 2};
+        const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, d);
         static const NoAccel kNone;
         visit_accel(m_accel ? *m_accel : kNone, [&](const auto& acc) {
             // 4. The light volume, when the light, TF or clipping changed since it was made.

@@ -10,6 +10,7 @@
 #include "accel/cursor.h"
 #include "lacuna/camera.h"
 #include "lacuna/renderer.h"
+#include "lacuna/volume.h"
 #include "render/ray_march_kernel.h"
 
 namespace lacuna {
@@ -17,6 +18,15 @@ namespace lacuna {
 // With early ray termination the cursor hands out occupied stretches of at most about this many
 // samples, so a ray that turns opaque early does not walk the structure to its far end.
 constexpr float kCursorChunk = 16.f;
+
+// World -> index space factor per axis (1 / spacing), and the sample distance of the lattice
+// (`step` smallest voxel spacings, world units).
+inline Vec3f inverse_spacing(const Volume& vol) {
+    return {float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y), float(1.0 / vol.spacing.z)};
+}
+inline float sample_distance(const Volume& vol, float step) {
+    return step * float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
+}
 
 // Pixel (x, y)'s camera ray moved into index space (t stays in world units).
 inline kernel::IndexRay index_ray(const Ray& wr, Vec3f inv_sp) {

@@ -22,6 +22,20 @@ struct Grid {
     int cell_x, cell_y, cell_z;  // dims - 2: largest cell index
 };
 
+// The grid of a volume's voxels (`dims` has .x, .y, .z), x fastest.
+template <class Index = int32_t, class T, class D>
+inline Grid<T, Index> make_grid(const T* data, const D& dims) {
+    return Grid<T, Index>{data,
+                          ptrdiff_t(dims.x),
+                          ptrdiff_t(dims.x) * ptrdiff_t(dims.y),
+                          float(dims.x - 1),
+                          float(dims.y - 1),
+                          float(dims.z - 1),
+                          dims.x - 2,
+                          dims.y - 2,
+                          dims.z - 2};
+}
+
 // Trilinear interpolation at index-space point (x,y,z), clamped into the box so rounding at
 // the box faces never reads outside the grid. The result lies between the min and max of the
 // cell's 8 corners (for integer voxel types exactly; see docs/architecture.md for float32).

@@ -91,20 +91,9 @@ template <class T, class Index, class S>
 void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
                  const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
                  RenderResult& out, std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
-    const Vec3i d = vol.dims();
-    kernel::Grid<T, Index> g{data,
-                      ptrdiff_t(d.x),
-                      ptrdiff_t(d.x) * ptrdiff_t(d.y),
-                      float(d.x - 1),
-                      float(d.y - 1),
-                      float(d.z - 1),
-                      d.x - 2,
-                      d.y - 2,
-                      d.z - 2};
-    const Vec3f inv_sp{float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y),
-                       float(1.0 / vol.spacing.z)};
-    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
-    const float dt = opt.step * min_sp;
+    const kernel::Grid<T, Index> g = kernel::make_grid<Index>(data, vol.dims());
+    const Vec3f inv_sp = inverse_spacing(vol);
+    const float dt = sample_distance(vol, opt.step);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     uint64_t tile_samples = 0, tile_rays = 0;
     for (int y = y0; y < y1; ++y) {

@@ -7,6 +7,7 @@
 #include "accel/cell_ranges.h"
 #include "core/parallel.h"
 #include "lacuna/error.h"
+#include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 
 namespace lacuna {
@@ -51,16 +52,10 @@ struct PixelRay {
 };
 bool pixel_ray(const Camera& cam, const Vec3f& inv_sp, const float hi[3], float dt, int x, int y,
                PixelRay& p) {
-    const Ray wr = cam.generate(float(x), float(y));
-    const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
-    p.r = kernel::IndexRay{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+    p.r = index_ray(cam.generate(float(x), float(y)), inv_sp);
     if (!kernel::intersect_box(p.r, hi, p.t_near, p.t_far)) return false;
-    p.k_end = std::max(int(std::ceil((p.t_far - p.t_near) / dt - 0.5f)), 0);
+    p.k_end = lattice_end(p.t_near, p.t_far, dt);
     return true;
-}
-
-Vec3f inverse_spacing(const Volume& vol) {
-    return {float(1.0 / vol.spacing.x), float(1.0 / vol.spacing.y), float(1.0 / vol.spacing.z)};
 }
 
 // Visible-cell samples of the pixels [x0,x1) x [y0,y1).
@@ -116,15 +111,11 @@ uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut,
         throw Error("sample analysis", "visible cells", "built for another volume");
     const std::vector<Rgba> table = step_corrected_lut(lut, opt.step);
     const ValueToLut map = lut.map();
-    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
-    const float dt = opt.step * min_sp;
+    const float dt = sample_distance(vol, opt.step);
     std::atomic<uint64_t> total{0};
     visit_voxels(vol, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
-        const kernel::Grid<T, int64_t> g{
-            data,           ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
-            float(d.x - 1), float(d.y - 1), float(d.z - 1),
-            d.x - 2,        d.y - 2,        d.z - 2};
+        const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, d);
         parallel_for_tiles(
             cam.width(), cam.height(), opt.tile, opt.threads, [&](int x0, int y0, int x1, int y1) {
                 total += count_tile(g, cells, vol, cam, table, map, dt, opt.ert, x0, y0, x1, y1);
@@ -142,8 +133,7 @@ uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut, c
 uint64_t count_lattice_samples(const Volume& vol, const Camera& cam, float step, int threads) {
     const Vec3i d = vol.dims();
     const Vec3f inv_sp = inverse_spacing(vol);
-    const float min_sp = float(std::min({vol.spacing.x, vol.spacing.y, vol.spacing.z}));
-    const float dt = step * min_sp;
+    const float dt = sample_distance(vol, step);
     const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
     std::atomic<uint64_t> total{0};
     parallel_for_tiles(cam.width(), cam.height(), 32, threads, [&](int x0, int y0, int x1, int y1) {

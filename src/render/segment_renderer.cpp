@@ -70,15 +70,11 @@ template <class T, class L, class S>
 void render_tile(const S& accel, const Volume& geom, const T* data, const L* labels, const Frame& f,
                  int x0, int y0, int x1, int y1) {
     const Vec3i d = geom.dims();
-    const kernel::Grid<T, int64_t> g{data,         ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
-                                     float(d.x - 1), float(d.y - 1), float(d.z - 1),
-                                     d.x - 2,      d.y - 2,       d.z - 2};
+    const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, d);
     const LabelGrid<L> lg{labels, ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
                           d.x - 1, d.y - 1, d.z - 1};
-    const Vec3f inv_sp{float(1.0 / geom.spacing.x), float(1.0 / geom.spacing.y),
-                       float(1.0 / geom.spacing.z)};
-    const float min_sp = float(std::min({geom.spacing.x, geom.spacing.y, geom.spacing.z}));
-    const float dt = f.opt.step * min_sp;
+    const Vec3f inv_sp = inverse_spacing(geom);
+    const float dt = sample_distance(geom, f.opt.step);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     const float ert = f.opt.ert;
     uint64_t tile_samples = 0, tile_rays = 0;

@@ -406,15 +406,7 @@ SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
         for (const BoxWork& w : work) batch.push_back(&w);
         visit_voxels(m_volume, [&](const auto* data) {
             using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
-            const kernel::Grid<T, int64_t> g{data,
-                                             ptrdiff_t(dims.x),
-                                             ptrdiff_t(dims.x) * ptrdiff_t(dims.y),
-                                             float(dims.x - 1),
-                                             float(dims.y - 1),
-                                             float(dims.z - 1),
-                                             dims.x - 2,
-                                             dims.y - 2,
-                                             dims.z - 2};
+            const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, dims);
             parallel_for_tiles(W, H, std::max(opt.tile, 1), opt.threads,
                                [&](int x0, int y0, int x1, int y1) {
                                    uint64_t n = 0;
