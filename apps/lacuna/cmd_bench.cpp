@@ -201,6 +201,8 @@ void register_bench(CLI::App& app) {
     register_bench_kdtree(*cmd);
     void register_bench_li(CLI::App&);  // cmd_bench_li.cpp
     register_bench_li(*cmd);
+    void register_bench_vtk(CLI::App&);  // cmd_bench_vtk.cpp
+    register_bench_vtk(*cmd);
 
     auto a = std::make_shared<FaludiArgs>();
     auto* f = cmd->add_subcommand(
