@@ -17,7 +17,7 @@
   const state = {
     camera: { azimuth: 30, elevation: 15, zoom: 1, pan: [0, 0] },
     renderer: 'march',
-    accel: 'bitfield',
+    accel: 'grid',
     ert: true,
     shading: false,
     clip: false,
@@ -71,7 +71,7 @@
     $('title').textContent = `lacuna · ${msg.volume.name} (${msg.volume.dims.join('×')} ${msg.volume.type})`;
     fillSelect($('renderer'), msg.renderers, state.renderer);
     state.renderer = $('renderer').value;
-    fillSelect($('accel'), msg.accels, msg.accels.includes('bitfield') ? 'bitfield' : msg.accels[0]);
+    fillSelect($('accel'), msg.accels, msg.accels.includes('grid') ? 'grid' : msg.accels[0]);
     state.accel = $('accel').value;
     // Segments only when the server loaded a label volume (`lacuna serve ... --labels FILE`).
     $('segments-row').hidden = !(msg.labels > 0);

@@ -30,7 +30,7 @@ struct RenderArgs {
     std::string tf;
     std::vector<std::string> tf_animate;
     int frames = 36;
-    std::string accel = "none";
+    std::string accel = "auto";  // default_accel() for the ray marcher (docs/cli.md)
     std::string out;
     std::string heatmap;
     int size = 1024;
@@ -234,6 +234,13 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 
 void run(RenderArgs& a) {
     const Setup s = validate(a);
+    // `auto` per renderer: the segment renderer's fastest exact structure is the label bitfield
+    // octree; the slicer slices the whole volume (its structures are the papers' boxes, chosen
+    // explicitly); the ray marcher takes default_accel().
+    if (a.accel == "auto") {
+        if (a.segments.active()) a.accel = "bitfield";
+        else if (a.slice.renderer == "slice") a.accel = "none";
+    }
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
     // Shading, lights, clipping, blend modes and jitter live in the ray marcher's feature kernel.
     if (s.ro.features.any() || !a.features.tf_back.empty()) {

@@ -29,11 +29,16 @@ enum class AccelKind {
     KdTree,     // kd-tree empty-space partition (kd-tree paper), rebuilt when the TF changes
     MinMaxInterval,  // the min-max octree as the bitfield paper tests it: empty when [min, max]
                      // misses the TF's one interval [first visible entry, last visible entry]
+    Grid,       // per-TF occupancy grid of bricks (apron-inclusive ranges), two-level 3D DDA
 };
 
 std::string to_string(AccelKind k);
 // Throws lacuna::Error("--accel", "structure", "unknown 'x'; expected one of: ...").
+// "auto" names the default structure (default_accel()).
 AccelKind parse_accel(const std::string& name);
+// What `--accel auto` (the default of every front end) selects: the fastest exact structure in
+// docs/benchmarks.md, the brick grid.
+AccelKind default_accel();
 std::vector<std::string> accel_names();
 // Every kind, None first: what the conformance tests and benchmarks iterate over.
 std::vector<AccelKind> all_accel_kinds();

@@ -14,7 +14,8 @@ constexpr Entry kAccels[] = {{AccelKind::None, "none"},         {AccelKind::Dist
                              {AccelKind::Chebyshev, "chebyshev"}, {AccelKind::Boolean, "boolean"},
                              {AccelKind::MinMax, "minmax"},     {AccelKind::Bitfield, "bitfield"},
                              {AccelKind::KdTree, "kdtree"},
-                             {AccelKind::MinMaxInterval, "minmax-interval"}};
+                             {AccelKind::MinMaxInterval, "minmax-interval"},
+                             {AccelKind::Grid, "grid"}};
 }  // namespace
 
 std::string to_string(AccelKind k) {
@@ -35,10 +36,13 @@ std::vector<AccelKind> all_accel_kinds() {
     return out;
 }
 
+AccelKind default_accel() { return AccelKind::Grid; }
+
 AccelKind parse_accel(const std::string& name) {
+    if (name == "auto") return default_accel();
     for (const auto& e : kAccels)
         if (name == e.name) return e.kind;
-    std::string valid;
+    std::string valid = "auto";
     for (const auto& e : kAccels) valid += (valid.empty() ? "" : ", ") + std::string(e.name);
     throw Error("--accel", "structure", "unknown '" + name + "'; expected one of: " + valid);
 }
@@ -53,6 +57,7 @@ std::unique_ptr<Accel> make_accel(AccelKind k, const Volume& volume, const Accel
         case AccelKind::Distance:
         case AccelKind::Chebyshev: return std::make_unique<DistanceMap>(k, volume, opts);
         case AccelKind::KdTree: return std::make_unique<KdTree>(volume, opts);
+        case AccelKind::Grid: return std::make_unique<BrickGrid>(volume, opts);
     }
     throw Error("--accel", "structure", "unhandled kind");
 }

@@ -3,6 +3,7 @@
 // then inlines into the sample loop.
 #pragma once
 #include "accel/bitfield_octree.h"
+#include "accel/brick_grid.h"
 #include "accel/boolean_octree.h"
 #include "accel/distance_map.h"
 #include "accel/kdtree.h"
@@ -21,6 +22,7 @@ decltype(auto) visit_accel(const Accel& a, F&& f) {
         case AccelKind::Distance:
         case AccelKind::Chebyshev: return f(static_cast<const DistanceMap&>(a));
         case AccelKind::KdTree: return f(static_cast<const KdTree&>(a));
+        case AccelKind::Grid: return f(static_cast<const BrickGrid&>(a));
         case AccelKind::None: break;
     }
     return f(static_cast<const NoAccel&>(a));

@@ -272,7 +272,89 @@ void rows_typed(const Volume& v, const T* data, ValueToLut map, int slab, int ch
     });
 }
 
+// apron_brick_ranges: per brick row (by, bz) the element-wise min/max of the voxel rows of its
+// window (plain loops the compiler vectorises), then per brick the min/max over its x window.
+// Integer voxels reduce raw values and map the extremes (the voxel bounds are monotone in the
+// value); float voxels map every voxel first, as rows_typed does.
+template <class T>
+void apron_typed(const Volume& v, const T* data, ValueToLut map, int edge, int threads,
+                 std::vector<uint16_t>& out_lo, std::vector<uint16_t>& out_hi) {
+    const Vec3i d = v.dims();
+    int cells[3], nb[3];
+    cell_counts(v, cells);
+    for (int a = 0; a < 3; ++a) nb[a] = (cells[a] + edge - 1) / edge;
+    const int dv[3] = {d.x, d.y, d.z};
+    out_lo.assign(size_t(nb[0]) * nb[1] * nb[2], 0);
+    out_hi.assign(out_lo.size(), 0);
+    const VoxelLut<T> vl(map, v.vis_range(), v.data_range());
+    constexpr bool kRaw = VoxelLut<T>::kTable;
+    using V = std::conditional_t<kRaw, T, uint16_t>;
+    // Voxel window of brick b on axis a (inclusive).
+    auto window = [&](int a, int b, int& v0, int& v1) {
+        v0 = std::max(0, edge * b - 1);
+        v1 = std::min(dv[a] - 1, edge * b + edge + 1);
+    };
+    const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
+    parallel_for(size_t(nb[1]) * size_t(nb[2]), threads, [&](size_t r0, size_t r1) {
+        std::vector<V> mn(static_cast<size_t>(d.x)), mx(static_cast<size_t>(d.x));
+        std::vector<uint16_t> flo(kRaw ? 0 : size_t(d.x)), fhi(kRaw ? 0 : size_t(d.x));
+        for (size_t r = r0; r < r1; ++r) {
+            const int by = int(r % size_t(nb[1])), bz = int(r / size_t(nb[1]));
+            int y0, y1, z0, z1;
+            window(1, by, y0, y1);
+            window(2, bz, z0, z1);
+            bool first = true;
+            for (int k = z0; k <= z1; ++k)
+                for (int j = y0; j <= y1; ++j) {
+                    const T* row = data + size_t(k) * sz + size_t(j) * sy;
+                    const V* lo_row;
+                    const V* hi_row;
+                    if constexpr (kRaw) {
+                        lo_row = row;
+                        hi_row = row;
+                    } else {
+                        for (int i = 0; i < d.x; ++i) vl.bounds(row[i], flo[size_t(i)], fhi[size_t(i)]);
+                        lo_row = flo.data();
+                        hi_row = fhi.data();
+                    }
+                    V* __restrict a = mn.data();
+                    V* __restrict b = mx.data();
+                    if (first) {
+                        std::copy(lo_row, lo_row + d.x, a);
+                        std::copy(hi_row, hi_row + d.x, b);
+                        first = false;
+                        continue;
+                    }
+                    for (int i = 0; i < d.x; ++i) a[i] = std::min(a[i], lo_row[i]);
+                    for (int i = 0; i < d.x; ++i) b[i] = std::max(b[i], hi_row[i]);
+                }
+            const size_t base = (size_t(bz) * nb[1] + by) * nb[0];
+            for (int bx = 0; bx < nb[0]; ++bx) {
+                int x0, x1;
+                window(0, bx, x0, x1);
+                V l = mn[size_t(x0)], h = mx[size_t(x0)];
+                for (int i = x0 + 1; i <= x1; ++i) {
+                    l = std::min(l, mn[size_t(i)]);
+                    h = std::max(h, mx[size_t(i)]);
+                }
+                if constexpr (kRaw) {
+                    out_lo[base + bx] = vl.lower(l);
+                    out_hi[base + bx] = vl.upper(h);
+                } else {
+                    out_lo[base + bx] = l;
+                    out_hi[base + bx] = h;
+                }
+            }
+        }
+    });
+}
+
 }  // namespace
+
+void apron_brick_ranges(const Volume& v, ValueToLut map, int edge, int threads,
+                        std::vector<uint16_t>& lo, std::vector<uint16_t>& hi) {
+    visit_voxels(v, [&](const auto* data) { apron_typed(v, data, map, edge, threads, lo, hi); });
+}
 
 void for_each_cell_row(const Volume& v, ValueToLut map, int slab, int threads,
                        const std::function<void(const CellRow&)>& fn) {

@@ -64,6 +64,14 @@ struct CellChunkRow {
 void for_each_cell_chunk_row(const Volume& v, ValueToLut map, int chunk, int threads,
                              const std::function<void(const CellChunkRow&)>& fn);
 
+// Per brick of `edge` cells the union of the LUT-entry ranges of the brick's cells and of a
+// one-cell apron around it: cells [edge*b - 1, edge*b + edge] on each axis, clipped to the grid
+// (voxels [edge*b - 1, edge*b + edge + 1]). The apron is what lets a traversal in float attribute
+// a sample to a brick without margins: a sample position within one voxel of the brick's box has
+// its cell among these. lo/hi get nb[0]*nb[1]*nb[2] entries, x fastest, nb = ceil(cells/edge).
+void apron_brick_ranges(const Volume& v, ValueToLut map, int edge, int threads,
+                        std::vector<uint16_t>& lo, std::vector<uint16_t>& hi);
+
 // Cells per axis (dims - 1) and blocks per axis for a block edge.
 inline void cell_counts(const Volume& v, int cells[3]) {
     const Vec3i d = v.dims();

@@ -22,11 +22,11 @@ namespace lacuna::simd {
 
 #if LACUNA_SIMD_SSE41
 
-// Positions of samples kb..kb+7: fractions fx/fy/fz and int32 voxel offsets.
+// Positions of the lattice samples k[0..7]: fractions fx/fy/fz and int32 voxel offsets.
 inline void positions8(float ox, float oy, float oz, float dx, float dy, float dz, float t_base,
-                       float dt, int kb, float hi_x, float hi_y, float hi_z, int cell_x, int cell_y,
-                       int cell_z, int32_t sy, int32_t sz, float* fx, float* fy, float* fz,
-                       int32_t* off) {
+                       float dt, const int32_t* k, float hi_x, float hi_y, float hi_z, int cell_x,
+                       int cell_y, int cell_z, int32_t sy, int32_t sz, float* fx, float* fy,
+                       float* fz, int32_t* off) {
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), vdt = _mm_set1_ps(dt),
                  vbase = _mm_set1_ps(t_base);
     const __m128 vo[3] = {_mm_set1_ps(ox), _mm_set1_ps(oy), _mm_set1_ps(oz)};
@@ -36,7 +36,7 @@ inline void positions8(float ox, float oy, float oz, float dx, float dy, float d
                               _mm_set1_epi32(cell_z)};
     float* const f[3] = {fx, fy, fz};
     for (int h = 0; h < 8; h += 4) {
-        const __m128i kk = _mm_add_epi32(_mm_set1_epi32(kb + h), _mm_setr_epi32(0, 1, 2, 3));
+        const __m128i kk = _mm_loadu_si128(reinterpret_cast<const __m128i*>(k + h));
         // t = t_base + (float(k) + 0.5) * dt
         const __m128 t =
             _mm_add_ps(vbase, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(kk), half), vdt));

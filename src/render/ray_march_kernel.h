@@ -89,42 +89,87 @@ inline bool intersect_box(const IndexRay& r, const float hi[3], float& t0, float
     return t0 < t1;
 }
 
-// Marches samples k in [k0, k1) of the lattice t_k = t_base + (k + 0.5)*dt. Returns the number
-// of samples taken; stops early (setting `done`) once opacity reaches `ert`.
+// The sample stream of one ray: the lattice samples t_k = t_base + (k + 0.5)*dt of any number
+// of runs [kb, ke), evaluated kBatch at a time *across run boundaries*, then composited front to
+// back in k order with early termination at `ert`.
 //
-// Samples are computed in batches of kBatch: positions, corner loads, interpolation and LUT
-// indices (SSE4.1 in core/simd.h for int32 offsets, plain loops otherwise), then a serial
-// compositing loop. The
-// arithmetic per sample is exactly that of trilinear() above (same operations, same order, no
-// fma contraction), so a batch gives the same bits as one sample at a time; samples of a batch
-// past an early termination are computed but never composited or counted.
+// Why a stream. Skipping splits a ray into a few short runs; a kernel that starts afresh per run
+// runs its full batches only while kBatch samples remain and takes the rest one at a time, which
+// on a head is a third to half of the surviving samples. Here a run only appends its indices; a
+// batch is evaluated when kBatch indices are queued, whichever runs they came from, and the ray's
+// last partial batch is padded (its extra lanes repeat the last index and are never composited).
+//
+// Every sample's position comes from its own k, with the arithmetic of trilinear() (same IEEE
+// operations in the same order, no fma contraction: SSE4.1 lanes in core/simd.h for int32
+// offsets, plain loops otherwise), so the result is that of one sample at a time, to the bit,
+// however the runs fall. Samples of a batch past an early termination are computed but never
+// composited or counted.
 inline constexpr int kBatch = 8;
 
 template <class T, class Index>
-inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, int k0, int k1,
-                      const Rgba* lut, ValueToLut map, float ert, Accum& acc, bool& done) {
-    uint32_t n = 0;
-    for (int kb = k0; kb < k1; kb += kBatch) {
-        const int m = k1 - kb < kBatch ? k1 - kb : kBatch;
-        if (m < kBatch) {
-            // A short tail (segments end anywhere): one sample at a time, same arithmetic.
-            for (int l = 0; l < m; ++l) {
-                const float t = t_base + (float(kb + l) + 0.5f) * dt;
-                const Rgba& c =
-                    lut[map(trilinear(g, r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz))];
-                ++n;
-                const float w = 1.f - acc.a;
-                acc.r += w * c.r;
-                acc.g += w * c.g;
-                acc.b += w * c.b;
-                acc.a += w * c.a;
-                if (acc.a >= ert) {
-                    done = true;
-                    return n;
-                }
-            }
-            return n;
+class RayStream {
+public:
+    RayStream(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, const Rgba* lut,
+              ValueToLut map, float ert, Accum& acc)
+        : m_g(g), m_r(r), m_t_base(t_base), m_dt(dt), m_lut(lut), m_map(map), m_ert(ert),
+          m_acc(acc) {}
+
+    // Queues the samples [kb, ke) (after every sample queued before); false once the ray is
+    // opaque, when further samples would be discarded.
+    bool add(int kb, int ke) {
+        while (kb < ke) {
+            const int take = std::min(ke - kb, kBatch - m_m);
+            for (int l = 0; l < take; ++l) m_k[m_m + l] = int32_t(kb + l);
+            m_m += take;
+            kb += take;
+            if (m_m == kBatch && !flush()) return false;
         }
+        return !m_done;
+    }
+    // Evaluates what is still queued.
+    void finish() {
+        if (m_m > 0 && !m_done) flush();
+        m_m = 0;
+    }
+    uint32_t samples() const { return m_n; }
+    bool done() const { return m_done; }
+
+private:
+    // Evaluates the m_m queued samples (padding the batch), composites them; false when opaque.
+    bool flush() {
+        for (int l = m_m; l < kBatch; ++l) m_k[l] = m_k[m_m - 1];
+        int entry[kBatch];
+        lut_entries(entry);
+        const int m = m_m;
+        m_m = 0;
+        // The accumulators in locals: the compositing chain stays in registers even where the
+        // compiler keeps flush() out of line.
+        Accum a = m_acc;
+        int l = 0;
+        bool opaque = false;
+        while (l < m) {
+            const Rgba& c = m_lut[entry[l]];
+            ++l;
+            const float w = 1.f - a.a;
+            a.r += w * c.r;
+            a.g += w * c.g;
+            a.b += w * c.b;
+            a.a += w * c.a;
+            if (a.a >= m_ert) {
+                opaque = true;
+                break;
+            }
+        }
+        m_acc = a;
+        m_n += uint32_t(l);
+        m_done = opaque;
+        return !opaque;
+    }
+
+    // LUT entries of the kBatch queued samples.
+    void lut_entries(int* entry) const {
+        const Grid<T, Index>& g = m_g;
+        const IndexRay& r = m_r;
         float fx[kBatch], fy[kBatch], fz[kBatch];
         Index off[kBatch];
         // 1. Lattice positions, clamped into the box; cell index and fractions.
@@ -135,14 +180,14 @@ inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, 
 #endif
 #if LACUNA_SIMD_SSE41
         if constexpr (kSimd) {
-            simd::positions8(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, t_base, dt, kb, g.hi_x, g.hi_y,
-                             g.hi_z, g.cell_x, g.cell_y, g.cell_z, int32_t(g.sy), int32_t(g.sz),
-                             fx, fy, fz, off);
+            simd::positions8(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, m_t_base, m_dt, m_k, g.hi_x,
+                             g.hi_y, g.hi_z, g.cell_x, g.cell_y, g.cell_z, int32_t(g.sy),
+                             int32_t(g.sz), fx, fy, fz, off);
         } else
 #endif
         {
             for (int l = 0; l < kBatch; ++l) {
-                const float t = t_base + (float(kb + l) + 0.5f) * dt;
+                const float t = m_t_base + (float(m_k[l]) + 0.5f) * m_dt;
                 float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
                 x = x < 0.f ? 0.f : (x > g.hi_x ? g.hi_x : x);
                 y = y < 0.f ? 0.f : (y > g.hi_y ? g.hi_y : y);
@@ -172,10 +217,9 @@ inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, 
             c111[l] = float(p[g.sz + g.sy + 1]);
         }
         // 3. Trilinear interpolation and the LUT entry.
-        int entry[kBatch];
 #if LACUNA_SIMD_SSE41
         if constexpr (kSimd) {
-            simd::interpolate8(c000, c100, c010, c110, c001, c101, c011, c111, fx, fy, fz, map,
+            simd::interpolate8(c000, c100, c010, c110, c001, c101, c011, c111, fx, fy, fz, m_map,
                                entry);
         } else
 #endif
@@ -186,25 +230,34 @@ inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, 
                 const float c01 = c001[l] + fx[l] * (c101[l] - c001[l]);
                 const float c11 = c011[l] + fx[l] * (c111[l] - c011[l]);
                 const float c0 = c00 + fy[l] * (c10 - c00), c1 = c01 + fy[l] * (c11 - c01);
-                entry[l] = map(c0 + fz[l] * (c1 - c0));
-            }
-        }
-        // 4. Front-to-back compositing, in order, with early termination.
-        for (int l = 0; l < m; ++l) {
-            const Rgba& c = lut[entry[l]];
-            ++n;
-            const float w = 1.f - acc.a;
-            acc.r += w * c.r;
-            acc.g += w * c.g;
-            acc.b += w * c.b;
-            acc.a += w * c.a;
-            if (acc.a >= ert) {
-                done = true;
-                return n;
+                entry[l] = m_map(c0 + fz[l] * (c1 - c0));
             }
         }
     }
-    return n;
+
+    const Grid<T, Index>& m_g;
+    IndexRay m_r;
+    float m_t_base, m_dt;
+    const Rgba* m_lut;
+    ValueToLut m_map;
+    float m_ert;
+    Accum& m_acc;
+    int32_t m_k[kBatch];
+    int m_m = 0;
+    uint32_t m_n = 0;
+    bool m_done = false;
+};
+
+// Marches the samples k in [k0, k1) on their own (one run of a stream). Returns the number of
+// samples taken; sets `done` once opacity reaches `ert`.
+template <class T, class Index>
+inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, int k0,
+                      int k1, const Rgba* lut, ValueToLut map, float ert, Accum& acc, bool& done) {
+    RayStream<T, Index> s(g, r, t_base, dt, lut, map, ert, acc);
+    s.add(k0, k1);
+    s.finish();
+    done = done || s.done();
+    return s.samples();
 }
 
 }  // namespace lacuna::kernel

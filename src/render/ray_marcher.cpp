@@ -106,13 +106,12 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
                 ++tile_rays;
                 typename S::Cursor cursor(accel, cursor_ray(r), t_near, t_far, dt,
                                           opt.ert < 1.f ? kCursorChunk * dt : 0.f);
-                bool done = false;
+                kernel::RayStream<T, Index> stream(g, r, t_near, dt, lut.data(), map, opt.ert,
+                                                   acc);
                 for_each_lattice_run(cursor, t_near, dt, lattice_end(t_near, t_far, dt),
-                                     [&](int kb, int ke) {
-                                         n += kernel::march(g, r, t_near, dt, kb, ke, lut.data(),
-                                                            map, opt.ert, acc, done);
-                                         return !done;
-                                     });
+                                     [&](int kb, int ke) { return stream.add(kb, ke); });
+                stream.finish();
+                n = stream.samples();
             }
             tile_samples += n;
             write_pixel(out, opt, x, y, acc, n);

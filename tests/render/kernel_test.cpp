@@ -83,6 +83,47 @@ void check_volume(const Volume& v, const TransferLut& lut, Rng& rng, const std::
             ASSERT_EQ(bits(acc.b), bits(ref.b)) << what << ", " << idx << ", ray " << ray;
             ASSERT_EQ(bits(acc.a), bits(ref.a)) << what << ", " << idx << ", ray " << ray;
         }
+        // The stream over runs with gaps (as skipping leaves them), against one sample at a
+        // time over exactly the samples of the runs, with and without early termination.
+        for (int variant = 0; variant < 4; ++variant) {
+            const float ert = variant < 2 ? 2.f : 0.3f + 0.6f * rng.uniform();
+            std::vector<std::pair<int, int>> runs;
+            for (int k = rng.range(0, 5); k < k_end;) {
+                const int k1 = std::min(k_end, k + rng.range(1, 30));
+                runs.push_back({k, k1});
+                k = k1 + rng.range(0, 12);
+            }
+            kernel::Accum want;
+            uint32_t want_n = 0;
+            bool stop = false;
+            for (auto [k0, k1] : runs)
+                for (int k = k0; k < k1 && !stop; ++k) {
+                    const float t = t_base + (float(k) + 0.5f) * dt;
+                    const Rgba& c = table[size_t(map(
+                        kernel::trilinear(g32, r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz)))];
+                    const float w = 1.f - want.a;
+                    want.r += w * c.r, want.g += w * c.g, want.b += w * c.b, want.a += w * c.a;
+                    ++want_n;
+                    stop = want.a >= ert;
+                }
+            kernel::Accum acc;
+            uint32_t n = 0;
+            auto run_stream = [&](const auto& g) {
+                kernel::RayStream s(g, r, t_base, dt, table.data(), map, ert, acc);
+                for (auto [k0, k1] : runs)
+                    if (!s.add(k0, k1)) break;
+                s.finish();
+                n = s.samples();
+            };
+            if (variant % 2 == 0) run_stream(g32); else run_stream(g64);
+            const std::string idx = std::string(variant % 2 == 0 ? "int32" : "int64") +
+                                    " stream, ert " + std::to_string(ert);
+            ASSERT_EQ(n, want_n) << what << ", " << idx << ", ray " << ray;
+            ASSERT_EQ(bits(acc.r), bits(want.r)) << what << ", " << idx << ", ray " << ray;
+            ASSERT_EQ(bits(acc.g), bits(want.g)) << what << ", " << idx << ", ray " << ray;
+            ASSERT_EQ(bits(acc.b), bits(want.b)) << what << ", " << idx << ", ray " << ray;
+            ASSERT_EQ(bits(acc.a), bits(want.a)) << what << ", " << idx << ", ray " << ray;
+        }
     }
 }
 

@@ -1,0 +1,254 @@
+// The brick grid (src/accel/brick_grid.h) against brute force: its apron ranges are the union of
+// the built cell ranges over each brick and its one-cell apron; its per-TF bits are the prefix
+// count of those ranges; and its DDA never skips a lattice sample the sampler computes in a
+// visible cell or with a visible value. The skip check uses the marcher's own position
+// expression for every skipped sample, on rays aimed at brick corners and edges, where a float
+// walk and the exact ray order crossings differently.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "accel/accel_impl.h"
+#include "accel/brick_grid.h"
+#include "accel_test_util.h"
+#include "lacuna/renderer.h"
+#include "render/pixel_driver.h"
+#include "render/ray_march_kernel.h"
+
+namespace lacuna {
+namespace {
+
+using namespace accel_test;
+
+TEST(BrickGrid, ApronRangesAreTheUnionOfTheBrickAndItsApronCells) {
+    Rng rng{9101};
+    for (int trial = 0; trial < 24; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 30), rng);
+        const ValueToLut map(v.vis_range(), kDefaultLutSize);
+        const BuiltRanges cells = built_ranges(v, map, -4);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 2);
+        BrickGrid g(v, o);
+        const int B = 1 << g.brick_log2();
+        const int* nb = g.bricks();
+        for (int a = 0; a < 3; ++a) ASSERT_EQ(nb[a], (cells.g.n[a] + B - 1) / B);
+        for (int z = 0; z < nb[2]; ++z)
+            for (int y = 0; y < nb[1]; ++y)
+                for (int x = 0; x < nb[0]; ++x) {
+                    int lo = 1 << 30, hi = -1;
+                    const int b[3] = {x, y, z};
+                    int c0[3], c1[3];
+                    for (int a = 0; a < 3; ++a) {
+                        c0[a] = std::max(0, b[a] * B - 1);
+                        c1[a] = std::min(cells.g.n[a] - 1, b[a] * B + B);
+                    }
+                    for (int k = c0[2]; k <= c1[2]; ++k)
+                        for (int j = c0[1]; j <= c1[1]; ++j)
+                            for (int i = c0[0]; i <= c1[0]; ++i) {
+                                lo = std::min(lo, cells.lo[cells.g.index(i, j, k)]);
+                                hi = std::max(hi, cells.hi[cells.g.index(i, j, k)]);
+                            }
+                    int glo, ghi;
+                    g.brick_range(x, y, z, glo, ghi);
+                    ASSERT_EQ(glo, lo) << describe(v, empty_lut(v.vis_range())) << " brick " << x
+                                       << "," << y << "," << z << " leaf " << B;
+                    ASSERT_EQ(ghi, hi) << "brick " << x << "," << y << "," << z;
+                }
+    }
+}
+
+TEST(BrickGrid, BitsAreThePrefixCountOfTheRangesAndBricksPastTheGridAreEmpty) {
+    Rng rng{9102};
+    for (int trial = 0; trial < 16; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 40), rng);
+        BrickGrid g(v, AccelOptions{});
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        const TransferLut lut =
+            random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng));
+        g.set_transfer_function(lut);
+        const int* nb = g.bricks();
+        int occupied = 0;
+        for (int z = 0; z < ((nb[2] + 3) & ~3); ++z)
+            for (int y = 0; y < ((nb[1] + 3) & ~3); ++y)
+                for (int x = 0; x < ((nb[0] + 3) & ~3); ++x) {
+                    const bool inside = x < nb[0] && y < nb[1] && z < nb[2];
+                    bool expect = false;
+                    if (inside) {
+                        int lo, hi;
+                        g.brick_range(x, y, z, lo, hi);
+                        expect = scan_visible(lut, lo, hi);
+                    }
+                    ASSERT_EQ(g.occupied(x, y, z), expect) << x << "," << y << "," << z;
+                    occupied += expect;
+                }
+        // An empty TF empties every word.
+        g.set_transfer_function(empty_lut(v.vis_range()));
+        for (int z = 0; z < nb[2]; ++z)
+            for (int y = 0; y < nb[1]; ++y)
+                for (int x = 0; x < nb[0]; ++x) ASSERT_EQ(g.word(x, y, z), 0u);
+        (void)occupied;
+    }
+}
+
+// A ray through two points of the box that lie on brick corners, edges or faces (or anywhere),
+// starting outside it; t scaled anisotropically. False if it misses the box.
+bool corner_ray(const float hi[3], int B, Rng& rng, kernel::IndexRay& r, float& t_near,
+                float& t_far) {
+    auto point = [&](int a) {
+        const int n = int(hi[a]);
+        if (rng.coin(4)) return hi[a] * rng.uniform();
+        return float(std::min(n, B * rng.range(0, n / B + 1)));
+    };
+    float p0[3], p1[3], d[3], len = 0;
+    for (int a = 0; a < 3; ++a) {
+        p0[a] = point(a);
+        p1[a] = rng.coin(5) ? p0[a] : point(a);  // sometimes in a plane
+        d[a] = p1[a] - p0[a];
+        len += d[a] * d[a];
+    }
+    if (len == 0.f) return false;
+    len = std::sqrt(len) * (0.3f + rng.uniform());
+    const float back = 0.5f + 8.f * rng.uniform();
+    r.dx = d[0] / len, r.dy = d[1] / len, r.dz = d[2] / len;
+    r.ox = p0[0] - back * r.dx, r.oy = p0[1] - back * r.dy, r.oz = p0[2] - back * r.dz;
+    return kernel::intersect_box(r, hi, t_near, t_far);
+}
+
+// The lemma the exactness argument rests on: the walk's steps tile [t_near, t_far], and every
+// lattice sample in a step's stretch, placed by the marcher's arithmetic, lies within far less
+// than one voxel of that step's brick (or block), so its cell is in the brick's apron.
+TEST(BrickGrid, WalkStepsTileTheRayAndHoldTheMarchersSamplePositions) {
+    Rng rng{9104};
+    int samples = 0, coarse = 0;
+    float worst = 0.f;
+    for (int trial = 0; trial < 30; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 2);
+        BrickGrid g(v, o);
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        g.set_transfer_function(
+            random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng, 2)));
+        const Vec3i dims = v.dims();
+        const float hi[3] = {float(dims.x - 1), float(dims.y - 1), float(dims.z - 1)};
+        const int B = 1 << g.brick_log2();
+        for (int ray = 0; ray < 80; ++ray) {
+            kernel::IndexRay r;
+            float t_near, t_far;
+            if (!corner_ray(hi, B, rng, r, t_near, t_far)) continue;
+            const float dt = 0.02f + 0.5f * rng.uniform();
+            const int k_end = lattice_end(t_near, t_far, dt);
+            BrickGrid::Cursor cursor(g, cursor_ray(r), t_near, t_far);
+            BrickGrid::Cursor::Step st;
+            float t_prev = t_near;
+            int k = 0, steps = 0;
+            while (cursor.step(st)) {
+                ASSERT_LT(++steps, 100000) << "the walk does not terminate";
+                ASSERT_EQ(st.t0, t_prev) << "steps must tile the ray";
+                ASSERT_LE(st.t0, st.t1);
+                t_prev = st.t1;
+                const int shift = g.brick_log2() + (st.coarse ? 2 : 0);
+                coarse += st.coarse;
+                if (st.coarse) {
+                    for (int a = 0; a < 3; ++a) ASSERT_LT(st.b[a], g.bricks()[a]);
+                    ASSERT_EQ(g.word(st.b[0], st.b[1], st.b[2]), 0u);
+                }
+                for (; k < k_end; ++k) {
+                    const float t = t_near + (float(k) + 0.5f) * dt;
+                    if (t > st.t1) break;
+                    float p[3] = {r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz};
+                    for (int a = 0; a < 3; ++a) {
+                        p[a] = p[a] < 0.f ? 0.f : (p[a] > hi[a] ? hi[a] : p[a]);
+                        const float lo = float((st.b[a] >> (shift - g.brick_log2())) << shift);
+                        const float up = std::min(hi[a], lo + float(1 << shift));
+                        const float out = std::max(lo - p[a], p[a] - up);
+                        worst = std::max(worst, out);
+                        ASSERT_LT(out, 1e-3f) << "sample " << k << " at t " << t << " is "
+                                              << out << " voxels outside its step's box on axis "
+                                              << a << (st.coarse ? " (block)" : " (brick)");
+                    }
+                    ++samples;
+                }
+            }
+            ASSERT_EQ(t_prev, t_far) << "the walk must end at t_far";
+            ASSERT_EQ(k, k_end) << "every lattice sample lies in a step";
+        }
+    }
+    EXPECT_GT(samples, 50000);
+    EXPECT_GT(coarse, 100) << "the cases must take coarse steps";
+    std::printf("worst excursion of a sample outside its step's box: %.3g voxels\n", worst);
+}
+
+// Every lattice sample the marcher would take but the grid's cursor skips, located with the
+// marcher's own arithmetic: it must be invisible (its cell's brute range and its trilinear
+// value). Rays start and end on brick corners, edges and faces.
+template <class T>
+void check_skipped_samples(const BrickGrid& g, const Volume& v, const T* data,
+                           const TransferLut& lut, const std::vector<uint8_t>& cell_visible,
+                           const CellGrid& cg, Rng& rng, int& skipped, int& kept) {
+    const auto grid = kernel::make_grid<int32_t>(data, v.dims());
+    const float hi[3] = {grid.hi_x, grid.hi_y, grid.hi_z};
+    const ValueToLut map = lut.map();
+    const int B = 1 << g.brick_log2();
+    for (int ray = 0; ray < 60; ++ray) {
+        kernel::IndexRay r;
+        float t_near, t_far;
+        if (!corner_ray(hi, B, rng, r, t_near, t_far)) continue;
+        const float dt = 0.05f + 0.6f * rng.uniform();
+        const int k_end = lattice_end(t_near, t_far, dt);
+        std::vector<uint8_t> taken(size_t(std::max(k_end, 0)), 0);
+        BrickGrid::Cursor cursor(g, cursor_ray(r), t_near, t_far, rng.coin() ? 0.f : dt,
+                                 rng.coin() ? 0.f : 16.f * dt);
+        for_each_lattice_run(cursor, t_near, dt, k_end, [&](int kb, int ke) {
+            for (int k = kb; k < ke; ++k) taken[size_t(k)] = 1;
+            return true;
+        });
+        for (int k = 0; k < k_end; ++k) {
+            if (taken[size_t(k)]) {
+                ++kept;
+                continue;
+            }
+            ++skipped;
+            const float t = t_near + (float(k) + 0.5f) * dt;
+            float p[3] = {r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz};
+            int cell[3];
+            for (int a = 0; a < 3; ++a) {
+                p[a] = p[a] < 0.f ? 0.f : (p[a] > hi[a] ? hi[a] : p[a]);
+                cell[a] = std::min(int(p[a]), cg.n[a] - 1);
+            }
+            const float value = kernel::trilinear(grid, p[0], p[1], p[2]);
+            ASSERT_FALSE(cell_visible[cg.index(cell[0], cell[1], cell[2])])
+                << "skipped sample " << k << " at t " << t << " lies in visible cell "
+                << cell_string(cell) << " (brick edge " << B << ")";
+            ASSERT_EQ(lut.entries[size_t(map(value))].a, 0.f)
+                << "skipped sample " << k << " is visible";
+        }
+    }
+}
+
+TEST(BrickGrid, CursorSkipsOnlyInvisibleSamplesOnRaysThroughBrickCornersAndEdges) {
+    Rng rng{9103};
+    int skipped = 0, kept = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        // Sparse volumes: a few visible voxels, often on brick corners.
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 40), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 2);
+        BrickGrid g(v, o);
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        const TransferLut lut =
+            random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng, 3));
+        g.set_transfer_function(lut);
+        const BruteRanges brute = brute_ranges(v, m);
+        const std::vector<uint8_t> vis = visible_cells(lut, brute.lo, brute.hi);
+        visit_voxels(v, [&](const auto* data) {
+            check_skipped_samples(g, v, data, lut, vis, brute.g, rng, skipped, kept);
+        });
+        if (HasFatalFailure()) return;
+    }
+    EXPECT_GT(skipped, 10000) << "the cases must skip";
+    EXPECT_GT(kept, 1000) << "the cases must keep samples";
+}
+
+}  // namespace
+}  // namespace lacuna
