@@ -43,20 +43,42 @@ inline int lattice_end(float t_base, float t_far, float dt) {
     return std::max(int(std::ceil((t_far - t_base) / dt - 0.5f)), 0);
 }
 
-// Calls fn(kb, ke) for the runs [kb, ke) of lattice samples t_k = t_base + (k + 0.5)*dt, k <
-// k_end, that lie in the cursor's segments, rounded outward (a few extra reference samples may
-// be taken, a visible one is never missed), in order and disjoint, until fn returns false.
+// The runs [kb, ke) of lattice samples t_k = t_base + (k + 0.5)*dt, k < k_end, that lie in the
+// cursor's segments, rounded outward (a few extra reference samples may be taken, a visible one
+// is never missed), in order and disjoint: a pull source, one run per next().
+template <class Cursor>
+class LatticeRuns {
+public:
+    LatticeRuns(Cursor& cursor, float t_base, float dt, int k_end)
+        : m_cursor(cursor), m_t_base(t_base), m_dt(dt), m_end(k_end) {}
+    bool next(int& kb, int& ke) {
+        Segment seg;
+        while (m_k < m_end && m_cursor.next(seg)) {
+            const int b = std::max(m_k, int(std::floor((seg.t0 - m_t_base) / m_dt - 0.5f)));
+            const int e = std::min(m_end, int(std::floor((seg.t1 - m_t_base) / m_dt - 0.5f)) + 2);
+            m_k = std::max(m_k, e);
+            if (e > b) {
+                kb = b;
+                ke = e;
+                return true;
+            }
+        }
+        return false;
+    }
+
+private:
+    Cursor& m_cursor;
+    float m_t_base, m_dt;
+    int m_end, m_k = 0;
+};
+
+// Calls fn(kb, ke) for those runs until fn returns false.
 template <class Cursor, class Fn>
 inline void for_each_lattice_run(Cursor& cursor, float t_base, float dt, int k_end, Fn&& fn) {
-    Segment seg;
-    int k = 0;
-    bool go = true;
-    while (go && k < k_end && cursor.next(seg)) {
-        const int kb = std::max(k, int(std::floor((seg.t0 - t_base) / dt - 0.5f)));
-        const int ke = std::min(k_end, int(std::floor((seg.t1 - t_base) / dt - 0.5f)) + 2);
-        if (ke > kb) go = fn(kb, ke);
-        k = std::max(k, ke);
-    }
+    LatticeRuns<Cursor> runs(cursor, t_base, dt, k_end);
+    int kb, ke;
+    while (runs.next(kb, ke))
+        if (!fn(kb, ke)) return;
 }
 
 // The same, one sample at a time: fn(k) returns false to stop.

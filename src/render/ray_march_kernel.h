@@ -10,6 +10,12 @@
 #include "lacuna/transfer_function.h"
 #include "core/simd.h"
 
+#if defined(__GNUC__)
+#define LACUNA_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define LACUNA_ALWAYS_INLINE inline
+#endif
+
 namespace lacuna::kernel {
 
 // Everything a sample needs, in index space. Index is the type of voxel offsets: int32_t for
@@ -112,11 +118,27 @@ public:
     RayStream(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, const Rgba* lut,
               ValueToLut map, float ert, Accum& acc)
         : m_g(g), m_r(r), m_t_base(t_base), m_dt(dt), m_lut(lut), m_map(map), m_ert(ert),
-          m_acc(acc) {}
+          m_acc(acc) {
+#if LACUNA_SIMD_SSE41
+        if constexpr (kSimd) {
+            m_sg = simd::Sample4Grid{{r.ox, r.oy, r.oz},
+                                     {r.dx, r.dy, r.dz},
+                                     t_base,
+                                     dt,
+                                     {g.hi_x, g.hi_y, g.hi_z},
+                                     {g.cell_x, g.cell_y, g.cell_z},
+                                     int32_t(g.sy),
+                                     int32_t(g.sz),
+                                     map.offset(),
+                                     map.scale(),
+                                     float(map.last())};
+        }
+#endif
+    }
 
     // Queues the samples [kb, ke) (after every sample queued before); false once the ray is
     // opaque, when further samples would be discarded.
-    bool add(int kb, int ke) {
+    LACUNA_ALWAYS_INLINE bool add(int kb, int ke) {
         while (kb < ke) {
             const int take = std::min(ke - kb, kBatch - m_m);
             for (int l = 0; l < take; ++l) m_k[m_m + l] = int32_t(kb + l);
@@ -127,7 +149,7 @@ public:
         return !m_done;
     }
     // Evaluates what is still queued.
-    void finish() {
+    LACUNA_ALWAYS_INLINE void finish() {
         if (m_m > 0 && !m_done) flush();
         m_m = 0;
     }
@@ -136,7 +158,7 @@ public:
 
 private:
     // Evaluates the m_m queued samples (padding the batch), composites them; false when opaque.
-    bool flush() {
+    LACUNA_ALWAYS_INLINE bool flush() {
         for (int l = m_m; l < kBatch; ++l) m_k[l] = m_k[m_m - 1];
         int entry[kBatch];
         lut_entries(entry);
@@ -166,25 +188,29 @@ private:
         return !opaque;
     }
 
+#if LACUNA_SIMD_SSE41
+    static constexpr bool kSimd = std::is_same_v<Index, int32_t> && kBatch == 8;
+    simd::Sample4Grid m_sg;
+#else
+    static constexpr bool kSimd = false;
+#endif
+
     // LUT entries of the kBatch queued samples.
-    void lut_entries(int* entry) const {
+    LACUNA_ALWAYS_INLINE void lut_entries(int* entry) const {
+#if LACUNA_SIMD_SSE41
+        if constexpr (kSimd) {
+            // The whole sample in registers, four lanes at a time (core/simd.h).
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(entry), simd::sample4(m_sg, m_g.data, m_k));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(entry + 4),
+                             simd::sample4(m_sg, m_g.data, m_k + 4));
+            return;
+        }
+#endif
         const Grid<T, Index>& g = m_g;
         const IndexRay& r = m_r;
         float fx[kBatch], fy[kBatch], fz[kBatch];
         Index off[kBatch];
         // 1. Lattice positions, clamped into the box; cell index and fractions.
-#if LACUNA_SIMD_SSE41
-        constexpr bool kSimd = std::is_same_v<Index, int32_t> && kBatch == 8;
-#else
-        constexpr bool kSimd = false;
-#endif
-#if LACUNA_SIMD_SSE41
-        if constexpr (kSimd) {
-            simd::positions8(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, m_t_base, m_dt, m_k, g.hi_x,
-                             g.hi_y, g.hi_z, g.cell_x, g.cell_y, g.cell_z, int32_t(g.sy),
-                             int32_t(g.sz), fx, fy, fz, off);
-        } else
-#endif
         {
             for (int l = 0; l < kBatch; ++l) {
                 const float t = m_t_base + (float(m_k[l]) + 0.5f) * m_dt;
@@ -217,12 +243,6 @@ private:
             c111[l] = float(p[g.sz + g.sy + 1]);
         }
         // 3. Trilinear interpolation and the LUT entry.
-#if LACUNA_SIMD_SSE41
-        if constexpr (kSimd) {
-            simd::interpolate8(c000, c100, c010, c110, c001, c101, c011, c111, fx, fy, fz, m_map,
-                               entry);
-        } else
-#endif
         {
             for (int l = 0; l < kBatch; ++l) {
                 const float c00 = c000[l] + fx[l] * (c100[l] - c000[l]);

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "accel/accel_impl.h"
 #include "core/parallel.h"
@@ -121,6 +122,96 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
     rays += tile_rays;
 }
 
+#if LACUNA_SIMD_SSE41
+// The same tile, four rays at a time (simd::march_lanes4: one ray per lane, each composited in
+// its own sample order, so the bits are those of render_tile). The scheduler keeps the lanes
+// full: a lane whose run ends pulls the ray's next run from its cursor; a lane whose ray is
+// done (no runs left, or opaque) writes its pixel and takes the tile's next ray.
+template <class T, class S>
+void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const Camera& cam,
+                       const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
+                       int x0, int y0, int x1, int y1, RenderResult& out,
+                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+    using Cursor = typename S::Cursor;
+    const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
+    const Vec3f inv_sp = inverse_spacing(vol);
+    const float dt = sample_distance(vol, opt.step);
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
+    const float chunk = opt.ert < 1.f ? kCursorChunk * dt : 0.f;
+    const simd::LaneGrid lg{dt,
+                            {g.hi_x, g.hi_y, g.hi_z},
+                            {g.cell_x, g.cell_y, g.cell_z},
+                            int32_t(g.sy),
+                            int32_t(g.sz),
+                            map.offset(),
+                            map.scale(),
+                            float(map.last()),
+                            int32_t(lut.size() - 1),  // the zero entry render() appends
+                            opt.ert};
+    struct Slot {
+        int x = 0, y = 0;
+        std::optional<Cursor> cursor;
+        std::optional<LatticeRuns<Cursor>> runs;
+    };
+    simd::Lanes4 L{};
+    Slot slot[4];
+    const int w = x1 - x0, npix = w * (y1 - y0);
+    int next_pixel = 0;
+    uint64_t tile_samples = 0, tile_rays = 0;
+    // Puts the tile's next ray with at least one run into lane l (pixels without one are written
+    // on the way); idles the lane when the tile has no rays left.
+    auto start = [&](int l) {
+        while (next_pixel < npix) {
+            const int x = x0 + next_pixel % w, y = y0 + next_pixel / w;
+            ++next_pixel;
+            const kernel::IndexRay r = index_ray(cam.generate(float(x), float(y)), inv_sp);
+            float t_near, t_far;
+            int kb, ke;
+            if (kernel::intersect_box(r, hi, t_near, t_far)) {
+                ++tile_rays;
+                Slot& sl = slot[l];
+                sl.runs.reset();
+                sl.cursor.emplace(accel, cursor_ray(r), t_near, t_far, dt, chunk);
+                sl.runs.emplace(*sl.cursor, t_near, dt, lattice_end(t_near, t_far, dt));
+                if (sl.runs->next(kb, ke)) {
+                    sl.x = x, sl.y = y;
+                    L.ox[l] = r.ox, L.oy[l] = r.oy, L.oz[l] = r.oz;
+                    L.dx[l] = r.dx, L.dy[l] = r.dy, L.dz[l] = r.dz;
+                    L.t_base[l] = t_near;
+                    L.k[l] = kb, L.kend[l] = ke;
+                    L.r[l] = L.g[l] = L.b[l] = L.a[l] = 0.f;
+                    L.n[l] = 0;
+                    L.active[l] = -1;
+                    return;
+                }
+            }
+            write_pixel(out, opt, x, y, kernel::Accum{}, 0);
+        }
+        L.active[l] = 0;
+        L.k[l] = L.kend[l] = 0;
+    };
+    for (int l = 0; l < 4; ++l) start(l);
+    const float* table = &lut[0].r;
+    while (L.active[0] | L.active[1] | L.active[2] | L.active[3]) {
+        const int need = simd::march_lanes4(L, lg, data, table);
+        for (int l = 0; l < 4; ++l) {
+            if (!(need >> l & 1)) continue;
+            int kb, ke;
+            if (!(L.a[l] >= opt.ert) && slot[l].runs->next(kb, ke)) {
+                L.k[l] = kb, L.kend[l] = ke;
+                continue;
+            }
+            write_pixel(out, opt, slot[l].x, slot[l].y,
+                        kernel::Accum{L.r[l], L.g[l], L.b[l], L.a[l]}, uint32_t(L.n[l]));
+            tile_samples += uint32_t(L.n[l]);
+            start(l);
+        }
+    }
+    samples += tile_samples;
+    rays += tile_rays;
+}
+#endif
+
 }  // namespace
 
 RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) const {
@@ -134,7 +225,8 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
     out.image = Image(cam.width(), cam.height());
     if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);
     if (opt.keep_float) out.rgba_float.assign(size_t(cam.width()) * cam.height() * 4, 0.f);
-    const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
+    std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
+    lut.push_back(Rgba{});  // the zero entry idle SIMD lanes composite (never mapped to)
     const ValueToLut map = m_lut.map();
     std::atomic<uint64_t> samples{0}, rays{0};
     const auto t0 = std::chrono::steady_clock::now();
@@ -145,11 +237,19 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
         visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
             parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                [&](int x0, int y0, int x1, int y1) {
+#if LACUNA_SIMD_SSE41
+                                   if (small)
+                                       render_tile_lanes<T>(s, m_volume, data, cam, opt, lut,
+                                                            map, x0, y0, x1, y1, out, samples,
+                                                            rays);
+                                   else
+#else
                                    if (small)
                                        render_tile<T, int32_t>(s, m_volume, data, cam, opt, lut,
                                                                map, x0, y0, x1, y1, out, samples,
                                                                rays);
                                    else
+#endif
                                        render_tile<T, int64_t>(s, m_volume, data, cam, opt, lut,
                                                                map, x0, y0, x1, y1, out, samples,
                                                                rays);
