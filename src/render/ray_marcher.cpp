@@ -7,6 +7,7 @@
 
 #include "accel/accel_impl.h"
 #include "core/parallel.h"
+#include "core/simd_lanes.h"
 #include "lacuna/error.h"
 #include "render/marcher_cache.h"
 #include "render/pixel_driver.h"
@@ -122,16 +123,16 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
     rays += tile_rays;
 }
 
-#if LACUNA_SIMD_SSE41
-// The same tile, four rays at a time (simd::march_lanes4: one ray per lane, each composited in
-// its own sample order, so the bits are those of render_tile). The scheduler keeps the lanes
-// full: a lane whose run ends pulls the ray's next run from its cursor; a lane whose ray is
-// done (no runs left, or opaque) writes its pixel and takes the tile's next ray.
-template <class T, class S>
+// The same tile, W rays at a time (core/simd_lanes.h: one ray per lane, each composited in its
+// own sample order, so the bits are those of render_tile). The scheduler keeps the lanes full: a
+// lane whose run ends pulls the ray's next run from its cursor; a lane whose ray is done (no runs
+// left, or opaque) writes its pixel and takes the tile's next ray. `march` runs the lanes until
+// one needs the scheduler and returns that lane mask.
+template <int W, class T, class S, class March>
 void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const Camera& cam,
                        const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
                        int x0, int y0, int x1, int y1, RenderResult& out,
-                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March march) {
     using Cursor = typename S::Cursor;
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
     const Vec3f inv_sp = inverse_spacing(vol);
@@ -153,10 +154,10 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
         std::optional<Cursor> cursor;
         std::optional<LatticeRuns<Cursor>> runs;
     };
-    simd::Lanes4 L{};
-    Slot slot[4];
+    simd::Lanes L{};
+    Slot slot[W];
     const int w = x1 - x0, npix = w * (y1 - y0);
-    int next_pixel = 0;
+    int next_pixel = 0, live = 0;
     uint64_t tile_samples = 0, tile_rays = 0;
     // Puts the tile's next ray with at least one run into lane l (pixels without one are written
     // on the way); idles the lane when the tile has no rays left.
@@ -182,6 +183,7 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
                     L.r[l] = L.g[l] = L.b[l] = L.a[l] = 0.f;
                     L.n[l] = 0;
                     L.active[l] = -1;
+                    ++live;
                     return;
                 }
             }
@@ -190,11 +192,11 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
         L.active[l] = 0;
         L.k[l] = L.kend[l] = 0;
     };
-    for (int l = 0; l < 4; ++l) start(l);
+    for (int l = 0; l < W; ++l) start(l);
     const float* table = &lut[0].r;
-    while (L.active[0] | L.active[1] | L.active[2] | L.active[3]) {
-        const int need = simd::march_lanes4(L, lg, data, table);
-        for (int l = 0; l < 4; ++l) {
+    while (live > 0) {
+        const int need = march(L, lg, data, table);
+        for (int l = 0; l < W; ++l) {
             if (!(need >> l & 1)) continue;
             int kb, ke;
             if (!(L.a[l] >= opt.ert) && slot[l].runs->next(kb, ke)) {
@@ -204,13 +206,48 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
             write_pixel(out, opt, slot[l].x, slot[l].y,
                         kernel::Accum{L.r[l], L.g[l], L.b[l], L.a[l]}, uint32_t(L.n[l]));
             tile_samples += uint32_t(L.n[l]);
+            --live;
             start(l);
         }
     }
     samples += tile_samples;
     rays += tile_rays;
 }
+
+// One tile on the active kernel path (simd::active_isa()); volumes of 2^31 voxels or more, and
+// the scalar path, march one ray at a time.
+template <class T, class S>
+void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol, const T* data,
+                    const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
+                    ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
+                    std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+    if (!small) {
+        render_tile<T, int64_t>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+                                samples, rays);
+        return;
+    }
+    switch (isa) {
+#if LACUNA_SIMD_X86
+        case simd::Isa::Avx512:
+            render_tile_lanes<16>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+                                  samples, rays, &simd::march_lanes16<T>);
+            return;
+        case simd::Isa::Avx2:
+            render_tile_lanes<8>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+                                 samples, rays, &simd::march_lanes8<T>);
+            return;
+#if defined(__SSE4_1__)
+        case simd::Isa::Sse41:
+            render_tile_lanes<4>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+                                 samples, rays, &simd::march_lanes4<T>);
+            return;
 #endif
+#endif
+        default:
+            render_tile<T, int32_t>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+                                    samples, rays);
+    }
+}
 
 }  // namespace
 
@@ -229,6 +266,7 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
     lut.push_back(Rgba{});  // the zero entry idle SIMD lanes composite (never mapped to)
     const ValueToLut map = m_lut.map();
     std::atomic<uint64_t> samples{0}, rays{0};
+    const simd::Isa isa = simd::active_isa();
     const auto t0 = std::chrono::steady_clock::now();
     visit_voxels(m_volume, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
@@ -237,22 +275,8 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
         visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
             parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                [&](int x0, int y0, int x1, int y1) {
-#if LACUNA_SIMD_SSE41
-                                   if (small)
-                                       render_tile_lanes<T>(s, m_volume, data, cam, opt, lut,
-                                                            map, x0, y0, x1, y1, out, samples,
-                                                            rays);
-                                   else
-#else
-                                   if (small)
-                                       render_tile<T, int32_t>(s, m_volume, data, cam, opt, lut,
-                                                               map, x0, y0, x1, y1, out, samples,
-                                                               rays);
-                                   else
-#endif
-                                       render_tile<T, int64_t>(s, m_volume, data, cam, opt, lut,
-                                                               map, x0, y0, x1, y1, out, samples,
-                                                               rays);
+                                   render_tile_on<T>(isa, small, s, m_volume, data, cam, opt, lut,
+                                                     map, x0, y0, x1, y1, out, samples, rays);
                                });
         });
     });

@@ -14,6 +14,7 @@
 
 #include "common/rng.h"
 #include "conformance/conformance_util.h"
+#include "core/simd_lanes.h"
 #include "lacuna/accel.h"
 #include "lacuna/io.h"
 #include "lacuna/renderer.h"
@@ -203,6 +204,64 @@ TEST(Conformance, StructuresSkipSamplesOnSparseVolumes) {
         EXPECT_LT(s * 2, none) << to_string(k) << " took " << s << " of " << none;
         m.set_accel(nullptr);
     }
+}
+
+// Every kernel path this CPU runs (scalar, SSE4.1, AVX2, AVX-512: core/simd_lanes.h) gives the
+// bytes and float accumulations of the scalar --accel none render, for every structure, with and
+// without early termination, on every voxel type.
+TEST(Conformance, EveryKernelPathIsExactForEveryStructure) {
+    struct Restore {
+        simd::Isa isa = simd::active_isa();
+        ~Restore() { simd::set_isa(isa); }
+    } restore;
+    std::vector<simd::Isa> paths;
+    for (simd::Isa i : {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
+        if (simd::isa_supported(i)) paths.push_back(i);
+    ASSERT_GE(paths.size(), 2u) << "at least the scalar path and one SIMD path";
+    Rng rng{2026};
+    int compared = 0;
+    for (int trial = 0; trial < 16; ++trial) {
+        const Volume v = test::random_volume(rng, 33);
+        TransferLut lut = random_lut(v.vis_range(), rng);
+        if (trial % 4 >= 2) {
+            // A dense LUT (2^18 entries, every one different): an interpolated value one ulp
+            // off usually lands in another entry, so a path that rounds differently shows.
+            lut.entries.resize(size_t(1) << 18);
+            for (Rgba& e : lut.entries)
+                e = {rng.uniform(), rng.uniform(), rng.uniform(), rng.coin(3) ? 0.f : rng.uniform()};
+        }
+        RenderOptions o;
+        o.keep_float = true;
+        o.count_samples = true;
+        o.step = 0.1f + 1.2f * rng.uniform();
+        o.ert = trial % 2 ? 0.85f : 2.f;
+        o.tile = rng.range(3, 17);
+        const Camera cam = random_camera(v, rng, 29);
+        RayMarcher m(v);
+        m.set_transfer_function(lut);
+        simd::set_isa(simd::Isa::Scalar);
+        const RenderResult ref = m.render(cam, o);
+        for (AccelKind k : all_accel_kinds()) {
+            auto accel = make_accel(k, v);
+            accel->set_transfer_function(lut);
+            m.set_accel(accel.get());
+            for (simd::Isa isa : paths) {
+                simd::set_isa(isa);
+                const RenderResult r = m.render(cam, o);
+                const std::string what = "trial " + std::to_string(trial) + " " +
+                                         to_string(v.type()) + " accel " + to_string(k) +
+                                         " path " + simd::to_string(isa);
+                ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
+                ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
+                                         ref.rgba_float.size() * sizeof(float)))
+                    << what << ": float accumulations differ";
+                if (k == AccelKind::None) ASSERT_EQ(r.sample_counts, ref.sample_counts) << what;
+                ++compared;
+            }
+            m.set_accel(nullptr);
+        }
+    }
+    EXPECT_GT(compared, 100);
 }
 
 }  // namespace

@@ -1,0 +1,515 @@
+// The ray marcher's lane kernels: W rays in lockstep, one per SIMD lane, for SSE4.1 (W = 4, the
+// x86-64-v2 baseline), AVX2 (W = 8) and AVX-512 (W = 16), chosen at run time (active_isa()). The
+// only other file with intrinsics is core/simd.h.
+//
+// Why lanes are rays. Front-to-back compositing is a serial chain per ray (w = 1 - a, then
+// a += w * c: a subtract, a multiply and an add of latency, ~10 cycles a sample), so one ray at a
+// time cannot go faster than that however wide its sampling is. W rays advance W chains in one
+// set of instructions, and wider registers make every other step (positions, corner loads,
+// lerps, LUT fetches) W samples per instruction.
+//
+// Bit-exactness. Each lane performs exactly the scalar operations of its own ray (trilinear(),
+// ValueToLut, the compositing of kernel::RayStream) in its own sample order: mul and add stay
+// separate (no FMA: -ffp-contract=off, no fma intrinsics), min/max return their second operand
+// on ties and NaN in every width, int conversions truncate. So every path gives the same bits.
+//
+// One portable binary. The AVX2 and AVX-512 kernels carry __attribute__((target(...))) rather
+// than per-file -m flags, so nothing else is compiled for those ISAs (no inline function of a
+// shared header can be emitted with AVX2 code and picked by the linker for everyone); they run
+// only after a CPUID check. No lambdas inside them (a lambda does not inherit the target).
+//
+// State lives in arrays (the scheduler in render/ray_marcher.cpp reads and refills single lanes)
+// and in registers while a kernel runs. A lane is valid while k < kend; an invalid lane
+// composites the all-zero LUT entry `zero_entry` (C + w * 0 = C exactly), so it changes nothing
+// and is not counted.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <type_traits>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define LACUNA_SIMD_X86 1
+#endif
+
+namespace lacuna::simd {
+
+// Kernel paths, narrowest first. Scalar = the one-ray-at-a-time RayStream with plain loops.
+enum class Isa { Scalar, Sse41, Avx2, Avx512 };
+std::string to_string(Isa i);
+// Throws lacuna::Error for an unknown name ("scalar", "sse4.1", "avx2", "avx512").
+Isa parse_isa(const std::string& name);
+bool isa_supported(Isa i);
+// The widest supported path, or what set_isa / the LACUNA_ISA environment variable chose
+// (clamped to what this CPU runs).
+Isa active_isa();
+void set_isa(Isa i);
+int lanes_of(Isa i);
+
+inline constexpr int kMaxLanes = 16;
+
+struct Lanes {
+    alignas(64) float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes];
+    alignas(64) float dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes];
+    alignas(64) float t_base[kMaxLanes];
+    alignas(64) int32_t k[kMaxLanes], kend[kMaxLanes];
+    alignas(64) float r[kMaxLanes], g[kMaxLanes], b[kMaxLanes], a[kMaxLanes];
+    alignas(64) int32_t n[kMaxLanes];       // samples composited
+    alignas(64) int32_t active[kMaxLanes];  // -1: the lane holds a ray; 0: idle
+};
+
+struct LaneGrid {
+    float dt;
+    float hi[3];
+    int cell[3];
+    int32_t sy, sz;
+    float lut_offset, lut_scale, lut_last;
+    int32_t zero_entry;
+    float ert;
+};
+
+#if LACUNA_SIMD_X86
+
+// ---- SSE4.1: four lanes (the baseline) -------------------------------------------------------
+#if defined(__SSE4_1__)
+// Marches every active lane until one of them needs the scheduler: its run ended (k == kend) or
+// it turned opaque (a >= ert). Returns that lane mask (bit l = lane l). `lut` holds RGBA entries
+// (premultiplied, step-corrected), entry zero_entry all zero.
+template <class T>
+inline int march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float* lut) {
+    const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.f);
+    const __m128 vdt = _mm_set1_ps(g.dt), vert = _mm_set1_ps(g.ert);
+    const __m128 vhi[3] = {_mm_set1_ps(g.hi[0]), _mm_set1_ps(g.hi[1]), _mm_set1_ps(g.hi[2])};
+    const __m128i vcell[3] = {_mm_set1_epi32(g.cell[0]), _mm_set1_epi32(g.cell[1]),
+                              _mm_set1_epi32(g.cell[2])};
+    const __m128i vsy = _mm_set1_epi32(g.sy), vsz = _mm_set1_epi32(g.sz);
+    const __m128 voff = _mm_set1_ps(g.lut_offset), vscale = _mm_set1_ps(g.lut_scale),
+                 vlast = _mm_set1_ps(g.lut_last);
+    const __m128i vzero_entry = _mm_set1_epi32(g.zero_entry);
+    const __m128 o[3] = {_mm_load_ps(s.ox), _mm_load_ps(s.oy), _mm_load_ps(s.oz)};
+    const __m128 d[3] = {_mm_load_ps(s.dx), _mm_load_ps(s.dy), _mm_load_ps(s.dz)};
+    const __m128 tb = _mm_load_ps(s.t_base);
+    const __m128i kend = _mm_load_si128(reinterpret_cast<const __m128i*>(s.kend));
+    const __m128i active = _mm_load_si128(reinterpret_cast<const __m128i*>(s.active));
+    __m128i k = _mm_load_si128(reinterpret_cast<const __m128i*>(s.k));
+    __m128i n = _mm_load_si128(reinterpret_cast<const __m128i*>(s.n));
+    __m128 ar = _mm_load_ps(s.r), ag = _mm_load_ps(s.g), ab = _mm_load_ps(s.b),
+           aa = _mm_load_ps(s.a);
+    const ptrdiff_t sy = g.sy, sz = g.sz, syz = ptrdiff_t(g.sy) + g.sz;
+    int need;
+    for (;;) {
+        const __m128i valid = _mm_cmplt_epi32(k, kend);
+        // 1. Positions t_k = t_base + (k + 0.5) * dt; cells, fractions, offsets.
+        const __m128 t = _mm_add_ps(tb, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(k), half), vdt));
+        __m128 f[3];
+        __m128i c[3];
+        for (int a = 0; a < 3; ++a) {
+            __m128 x = _mm_add_ps(o[a], _mm_mul_ps(t, d[a]));
+            x = _mm_max_ps(zero, _mm_min_ps(vhi[a], x));
+            c[a] = _mm_min_epi32(_mm_cvttps_epi32(x), vcell[a]);
+            f[a] = _mm_sub_ps(x, _mm_cvtepi32_ps(c[a]));
+        }
+        __m128i off = _mm_add_epi32(
+            _mm_add_epi32(_mm_mullo_epi32(c[2], vsz), _mm_mullo_epi32(c[1], vsy)), c[0]);
+        // Idle lanes read voxel 0 (their position is garbage); their entry is replaced below.
+        off = _mm_and_si128(off, active);
+        alignas(16) int32_t ofs[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(ofs), off);
+        // 2. Corners as pairs (as sample4).
+        __m128 lo[4], hi[4];
+        if constexpr (sizeof(T) == 1) {
+            __m128i v01 = _mm_setzero_si128(), v23 = _mm_setzero_si128();
+            auto pair = [](const T* p) {
+                uint16_t w;
+                __builtin_memcpy(&w, p, 2);
+                return int(w);
+            };
+#define LACUNA_PAIRS(l)                                        \
+    {                                                          \
+        const T* p = data + ofs[l];                            \
+        v01 = _mm_insert_epi16(v01, pair(p), l);               \
+        v01 = _mm_insert_epi16(v01, pair(p + sy), 4 + l);      \
+        v23 = _mm_insert_epi16(v23, pair(p + sz), l);          \
+        v23 = _mm_insert_epi16(v23, pair(p + syz), 4 + l);     \
+    }
+            LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+#undef LACUNA_PAIRS
+            const __m128i m_lo0 = _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
+            const __m128i m_hi0 = _mm_setr_epi8(1, -1, -1, -1, 3, -1, -1, -1, 5, -1, -1, -1, 7, -1, -1, -1);
+            const __m128i m_lo1 = _mm_setr_epi8(8, -1, -1, -1, 10, -1, -1, -1, 12, -1, -1, -1, 14, -1, -1, -1);
+            const __m128i m_hi1 = _mm_setr_epi8(9, -1, -1, -1, 11, -1, -1, -1, 13, -1, -1, -1, 15, -1, -1, -1);
+            lo[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo0));
+            hi[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi0));
+            lo[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo1));
+            hi[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi1));
+            lo[2] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_lo0));
+            hi[2] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_hi0));
+            lo[3] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_lo1));
+            hi[3] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_hi1));
+        } else if constexpr (sizeof(T) == 2) {
+            __m128i v[4] = {_mm_setzero_si128(), _mm_setzero_si128(), _mm_setzero_si128(),
+                            _mm_setzero_si128()};
+            auto pair = [](const T* p) {
+                int32_t w;
+                __builtin_memcpy(&w, p, 4);
+                return w;
+            };
+#define LACUNA_PAIRS(l)                                  \
+    {                                                    \
+        const T* p = data + ofs[l];                      \
+        v[0] = _mm_insert_epi32(v[0], pair(p), l);       \
+        v[1] = _mm_insert_epi32(v[1], pair(p + sy), l);  \
+        v[2] = _mm_insert_epi32(v[2], pair(p + sz), l);  \
+        v[3] = _mm_insert_epi32(v[3], pair(p + syz), l); \
+    }
+            LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+#undef LACUNA_PAIRS
+            for (int q = 0; q < 4; ++q) {
+                if constexpr (std::is_signed_v<T>) {
+                    lo[q] = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(v[q], 16), 16));
+                    hi[q] = _mm_cvtepi32_ps(_mm_srai_epi32(v[q], 16));
+                } else {
+                    lo[q] = _mm_cvtepi32_ps(_mm_and_si128(v[q], _mm_set1_epi32(0xffff)));
+                    hi[q] = _mm_cvtepi32_ps(_mm_srli_epi32(v[q], 16));
+                }
+            }
+        } else {
+            const ptrdiff_t step[4] = {0, sy, sz, syz};
+            for (int q = 0; q < 4; ++q) {
+                const __m64* p0 = reinterpret_cast<const __m64*>(data + ofs[0] + step[q]);
+                const __m64* p1 = reinterpret_cast<const __m64*>(data + ofs[1] + step[q]);
+                const __m64* p2 = reinterpret_cast<const __m64*>(data + ofs[2] + step[q]);
+                const __m64* p3 = reinterpret_cast<const __m64*>(data + ofs[3] + step[q]);
+                const __m128 x01 = _mm_loadh_pi(_mm_loadl_pi(zero, p0), p1);
+                const __m128 x23 = _mm_loadh_pi(_mm_loadl_pi(zero, p2), p3);
+                lo[q] = _mm_shuffle_ps(x01, x23, _MM_SHUFFLE(2, 0, 2, 0));
+                hi[q] = _mm_shuffle_ps(x01, x23, _MM_SHUFFLE(3, 1, 3, 1));
+            }
+        }
+        // 3. Trilinear lerps (trilinear()'s order) and the LUT entry (ValueToLut).
+        auto lerp = [](__m128 a, __m128 b, __m128 w) {
+            return _mm_add_ps(a, _mm_mul_ps(w, _mm_sub_ps(b, a)));
+        };
+        const __m128 c00 = lerp(lo[0], hi[0], f[0]), c10 = lerp(lo[1], hi[1], f[0]);
+        const __m128 c01 = lerp(lo[2], hi[2], f[0]), c11 = lerp(lo[3], hi[3], f[0]);
+        const __m128 c0 = lerp(c00, c10, f[1]), c1 = lerp(c01, c11, f[1]);
+        const __m128 v = lerp(c0, c1, f[2]);
+        __m128 u = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(v, voff), vscale), half);
+        u = _mm_max_ps(zero, _mm_min_ps(vlast, u));
+        const __m128i entry = _mm_blendv_epi8(vzero_entry, _mm_cvttps_epi32(u), valid);
+        // 4. Composite one sample per lane: RGBA of the 4 entries, transposed to SoA.
+        alignas(16) int32_t e[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(e), entry);
+        __m128 cr = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[0])), cg = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[1]));
+        __m128 cb = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[2])), ca = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[3]));
+        _MM_TRANSPOSE4_PS(cr, cg, cb, ca);
+        const __m128 w = _mm_sub_ps(one, aa);
+        ar = _mm_add_ps(ar, _mm_mul_ps(w, cr));
+        ag = _mm_add_ps(ag, _mm_mul_ps(w, cg));
+        ab = _mm_add_ps(ab, _mm_mul_ps(w, cb));
+        aa = _mm_add_ps(aa, _mm_mul_ps(w, ca));
+        n = _mm_sub_epi32(n, valid);
+        k = _mm_sub_epi32(k, valid);  // k + 1 on valid lanes
+        // 5. A lane needs the scheduler when its run is over or it is opaque.
+        const __m128i over = _mm_or_si128(_mm_cmpeq_epi32(k, kend),
+                                          _mm_castps_si128(_mm_cmpge_ps(aa, vert)));
+        need = _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(over, active)));
+        if (need) break;
+    }
+    _mm_store_si128(reinterpret_cast<__m128i*>(s.k), k);
+    _mm_store_si128(reinterpret_cast<__m128i*>(s.n), n);
+    _mm_store_ps(s.r, ar);
+    _mm_store_ps(s.g, ag);
+    _mm_store_ps(s.b, ab);
+    _mm_store_ps(s.a, aa);
+    return need;
+}
+
+#endif
+
+// ---- AVX2: eight lanes ---------------------------------------------------------------------
+#define LACUNA_AVX2 __attribute__((target("avx2")))
+
+template <class T>
+LACUNA_AVX2 int march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut) {
+    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.f);
+    const __m256 vdt = _mm256_set1_ps(g.dt), vert = _mm256_set1_ps(g.ert);
+    const __m256 vhi0 = _mm256_set1_ps(g.hi[0]), vhi1 = _mm256_set1_ps(g.hi[1]),
+                 vhi2 = _mm256_set1_ps(g.hi[2]);
+    const __m256i vc0 = _mm256_set1_epi32(g.cell[0]), vc1 = _mm256_set1_epi32(g.cell[1]),
+                  vc2 = _mm256_set1_epi32(g.cell[2]);
+    const __m256i vsy = _mm256_set1_epi32(g.sy), vsz = _mm256_set1_epi32(g.sz);
+    const __m256 voff = _mm256_set1_ps(g.lut_offset), vscale = _mm256_set1_ps(g.lut_scale),
+                 vlast = _mm256_set1_ps(g.lut_last);
+    const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
+    const __m256 ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz);
+    const __m256 dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz);
+    const __m256 tb = _mm256_load_ps(s.t_base);
+    const __m256i kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));
+    const __m256i active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));
+    __m256i k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));
+    __m256i n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));
+    __m256 ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b),
+           aa = _mm256_load_ps(s.a);
+    // Gather offsets of the corner pairs (in elements): 0, sy, sz, sy + sz. For uint8 a 32-bit
+    // gather reads 4 bytes; the pairs past the first are read from 2 bytes before them (bytes 2
+    // and 3 of the word) so no read passes the last voxel, and the first from its own offset.
+    constexpr bool kByte = sizeof(T) == 1;
+    const __m256i q1 = _mm256_set1_epi32(kByte ? g.sy - 2 : g.sy);
+    const __m256i q2 = _mm256_set1_epi32(kByte ? g.sz - 2 : g.sz);
+    const __m256i q3 = _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz);
+    int need;
+    for (;;) {
+        const __m256i valid = _mm256_cmpgt_epi32(kend, k);
+        const __m256 t =
+            _mm256_add_ps(tb, _mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(k), half), vdt));
+        __m256 x = _mm256_add_ps(ox, _mm256_mul_ps(t, dx));
+        __m256 y = _mm256_add_ps(oy, _mm256_mul_ps(t, dy));
+        __m256 z = _mm256_add_ps(oz, _mm256_mul_ps(t, dz));
+        x = _mm256_max_ps(zero, _mm256_min_ps(vhi0, x));
+        y = _mm256_max_ps(zero, _mm256_min_ps(vhi1, y));
+        z = _mm256_max_ps(zero, _mm256_min_ps(vhi2, z));
+        const __m256i ci = _mm256_min_epi32(_mm256_cvttps_epi32(x), vc0);
+        const __m256i cj = _mm256_min_epi32(_mm256_cvttps_epi32(y), vc1);
+        const __m256i ck = _mm256_min_epi32(_mm256_cvttps_epi32(z), vc2);
+        const __m256 fx = _mm256_sub_ps(x, _mm256_cvtepi32_ps(ci));
+        const __m256 fy = _mm256_sub_ps(y, _mm256_cvtepi32_ps(cj));
+        const __m256 fz = _mm256_sub_ps(z, _mm256_cvtepi32_ps(ck));
+        __m256i off = _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_mullo_epi32(ck, vsz), _mm256_mullo_epi32(cj, vsy)), ci);
+        off = _mm256_and_si256(off, active);  // idle lanes read voxel 0
+        __m256 c000, c100, c010, c110, c001, c101, c011, c111;
+        if constexpr (kByte) {
+            const int* base = reinterpret_cast<const int*>(data);
+            const __m256i w0 = _mm256_i32gather_epi32(base, off, 1);
+            const __m256i w1 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q1), 1);
+            const __m256i w2 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q2), 1);
+            const __m256i w3 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q3), 1);
+            const __m256i m = _mm256_set1_epi32(0xff);
+            c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
+            c100 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w0, 8), m));
+            c010 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w1, 16), m));
+            c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 24));
+            c001 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w2, 16), m));
+            c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 24));
+            c011 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w3, 16), m));
+            c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 24));
+        } else if constexpr (sizeof(T) == 2) {
+            const int* base = reinterpret_cast<const int*>(data);
+            const __m256i w0 = _mm256_i32gather_epi32(base, off, 2);
+            const __m256i w1 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q1), 2);
+            const __m256i w2 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q2), 2);
+            const __m256i w3 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q3), 2);
+            if constexpr (std::is_signed_v<T>) {
+                c000 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w0, 16), 16));
+                c010 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w1, 16), 16));
+                c001 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w2, 16), 16));
+                c011 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w3, 16), 16));
+                c100 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w0, 16));
+                c110 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w1, 16));
+                c101 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w2, 16));
+                c111 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w3, 16));
+            } else {
+                const __m256i m = _mm256_set1_epi32(0xffff);
+                c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
+                c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
+                c001 = _mm256_cvtepi32_ps(_mm256_and_si256(w2, m));
+                c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
+                c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 16));
+                c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 16));
+                c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 16));
+                c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 16));
+            }
+        } else {
+            const float* base = reinterpret_cast<const float*>(data);
+            const __m256i o1 = _mm256_add_epi32(off, q1), o2 = _mm256_add_epi32(off, q2),
+                          o3 = _mm256_add_epi32(off, q3);
+            c000 = _mm256_i32gather_ps(base, off, 4);
+            c100 = _mm256_i32gather_ps(base + 1, off, 4);
+            c010 = _mm256_i32gather_ps(base, o1, 4);
+            c110 = _mm256_i32gather_ps(base + 1, o1, 4);
+            c001 = _mm256_i32gather_ps(base, o2, 4);
+            c101 = _mm256_i32gather_ps(base + 1, o2, 4);
+            c011 = _mm256_i32gather_ps(base, o3, 4);
+            c111 = _mm256_i32gather_ps(base + 1, o3, 4);
+        }
+        // Trilinear lerps a + w * (b - a), in trilinear()'s order; then ValueToLut.
+        const __m256 c00 = _mm256_add_ps(c000, _mm256_mul_ps(fx, _mm256_sub_ps(c100, c000)));
+        const __m256 c10 = _mm256_add_ps(c010, _mm256_mul_ps(fx, _mm256_sub_ps(c110, c010)));
+        const __m256 c01 = _mm256_add_ps(c001, _mm256_mul_ps(fx, _mm256_sub_ps(c101, c001)));
+        const __m256 c11 = _mm256_add_ps(c011, _mm256_mul_ps(fx, _mm256_sub_ps(c111, c011)));
+        const __m256 c0 = _mm256_add_ps(c00, _mm256_mul_ps(fy, _mm256_sub_ps(c10, c00)));
+        const __m256 c1 = _mm256_add_ps(c01, _mm256_mul_ps(fy, _mm256_sub_ps(c11, c01)));
+        const __m256 v = _mm256_add_ps(c0, _mm256_mul_ps(fz, _mm256_sub_ps(c1, c0)));
+        __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
+        u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
+        const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), valid);
+        // Composite one sample per lane (RGBA gathered from the LUT, SoA).
+        const __m256i e4 = _mm256_slli_epi32(entry, 2);
+        const __m256 cr = _mm256_i32gather_ps(lut, e4, 4);
+        const __m256 cg = _mm256_i32gather_ps(lut + 1, e4, 4);
+        const __m256 cb = _mm256_i32gather_ps(lut + 2, e4, 4);
+        const __m256 ca = _mm256_i32gather_ps(lut + 3, e4, 4);
+        const __m256 w = _mm256_sub_ps(one, aa);
+        ar = _mm256_add_ps(ar, _mm256_mul_ps(w, cr));
+        ag = _mm256_add_ps(ag, _mm256_mul_ps(w, cg));
+        ab = _mm256_add_ps(ab, _mm256_mul_ps(w, cb));
+        aa = _mm256_add_ps(aa, _mm256_mul_ps(w, ca));
+        n = _mm256_sub_epi32(n, valid);
+        k = _mm256_sub_epi32(k, valid);
+        const __m256i over = _mm256_or_si256(
+            _mm256_cmpeq_epi32(k, kend), _mm256_castps_si256(_mm256_cmp_ps(aa, vert, _CMP_GE_OS)));
+        need = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(over, active)));
+        if (need) break;
+    }
+    _mm256_store_si256(reinterpret_cast<__m256i*>(s.k), k);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(s.n), n);
+    _mm256_store_ps(s.r, ar);
+    _mm256_store_ps(s.g, ag);
+    _mm256_store_ps(s.b, ab);
+    _mm256_store_ps(s.a, aa);
+    return need;
+}
+
+// ---- AVX-512: sixteen lanes ------------------------------------------------------------------
+#define LACUNA_AVX512 __attribute__((target("avx512f")))
+
+template <class T>
+LACUNA_AVX512 int march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut) {
+    const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
+    const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
+    const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
+                 vhi2 = _mm512_set1_ps(g.hi[2]);
+    const __m512i vc0 = _mm512_set1_epi32(g.cell[0]), vc1 = _mm512_set1_epi32(g.cell[1]),
+                  vc2 = _mm512_set1_epi32(g.cell[2]);
+    const __m512i vsy = _mm512_set1_epi32(g.sy), vsz = _mm512_set1_epi32(g.sz);
+    const __m512 voff = _mm512_set1_ps(g.lut_offset), vscale = _mm512_set1_ps(g.lut_scale),
+                 vlast = _mm512_set1_ps(g.lut_last);
+    const __m512i vzero_entry = _mm512_set1_epi32(g.zero_entry), ione = _mm512_set1_epi32(1);
+    const __m512 ox = _mm512_load_ps(s.ox), oy = _mm512_load_ps(s.oy), oz = _mm512_load_ps(s.oz);
+    const __m512 dx = _mm512_load_ps(s.dx), dy = _mm512_load_ps(s.dy), dz = _mm512_load_ps(s.dz);
+    const __m512 tb = _mm512_load_ps(s.t_base);
+    const __m512i kend = _mm512_load_si512(s.kend);
+    const __mmask16 active =
+        _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active), _mm512_setzero_si512());
+    __m512i k = _mm512_load_si512(s.k);
+    __m512i n = _mm512_load_si512(s.n);
+    __m512 ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b),
+           aa = _mm512_load_ps(s.a);
+    constexpr bool kByte = sizeof(T) == 1;
+    const __m512i q1 = _mm512_set1_epi32(kByte ? g.sy - 2 : g.sy);
+    const __m512i q2 = _mm512_set1_epi32(kByte ? g.sz - 2 : g.sz);
+    const __m512i q3 = _mm512_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz);
+    int need;
+    for (;;) {
+        const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
+        const __m512 t =
+            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), vdt));
+        __m512 x = _mm512_add_ps(ox, _mm512_mul_ps(t, dx));
+        __m512 y = _mm512_add_ps(oy, _mm512_mul_ps(t, dy));
+        __m512 z = _mm512_add_ps(oz, _mm512_mul_ps(t, dz));
+        x = _mm512_max_ps(zero, _mm512_min_ps(vhi0, x));
+        y = _mm512_max_ps(zero, _mm512_min_ps(vhi1, y));
+        z = _mm512_max_ps(zero, _mm512_min_ps(vhi2, z));
+        const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), vc0);
+        const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), vc1);
+        const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(z), vc2);
+        const __m512 fx = _mm512_sub_ps(x, _mm512_cvtepi32_ps(ci));
+        const __m512 fy = _mm512_sub_ps(y, _mm512_cvtepi32_ps(cj));
+        const __m512 fz = _mm512_sub_ps(z, _mm512_cvtepi32_ps(ck));
+        __m512i off = _mm512_add_epi32(
+            _mm512_add_epi32(_mm512_mullo_epi32(ck, vsz), _mm512_mullo_epi32(cj, vsy)), ci);
+        off = _mm512_maskz_mov_epi32(active, off);  // idle lanes read voxel 0
+        __m512 c000, c100, c010, c110, c001, c101, c011, c111;
+        if constexpr (kByte) {
+            const __m512i w0 = _mm512_i32gather_epi32(off, data, 1);
+            const __m512i w1 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q1), data, 1);
+            const __m512i w2 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q2), data, 1);
+            const __m512i w3 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q3), data, 1);
+            const __m512i m = _mm512_set1_epi32(0xff);
+            c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
+            c100 = _mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w0, 8), m));
+            c010 = _mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w1, 16), m));
+            c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 24));
+            c001 = _mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w2, 16), m));
+            c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 24));
+            c011 = _mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w3, 16), m));
+            c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 24));
+        } else if constexpr (sizeof(T) == 2) {
+            const __m512i w0 = _mm512_i32gather_epi32(off, data, 2);
+            const __m512i w1 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q1), data, 2);
+            const __m512i w2 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q2), data, 2);
+            const __m512i w3 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q3), data, 2);
+            if constexpr (std::is_signed_v<T>) {
+                c000 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w0, 16), 16));
+                c010 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w1, 16), 16));
+                c001 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w2, 16), 16));
+                c011 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w3, 16), 16));
+                c100 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w0, 16));
+                c110 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w1, 16));
+                c101 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w2, 16));
+                c111 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w3, 16));
+            } else {
+                const __m512i m = _mm512_set1_epi32(0xffff);
+                c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
+                c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
+                c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
+                c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
+                c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 16));
+                c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 16));
+                c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 16));
+                c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 16));
+            }
+        } else {
+            const float* base = reinterpret_cast<const float*>(data);
+            const __m512i o1 = _mm512_add_epi32(off, q1), o2 = _mm512_add_epi32(off, q2),
+                          o3 = _mm512_add_epi32(off, q3);
+            c000 = _mm512_i32gather_ps(off, base, 4);
+            c100 = _mm512_i32gather_ps(off, base + 1, 4);
+            c010 = _mm512_i32gather_ps(o1, base, 4);
+            c110 = _mm512_i32gather_ps(o1, base + 1, 4);
+            c001 = _mm512_i32gather_ps(o2, base, 4);
+            c101 = _mm512_i32gather_ps(o2, base + 1, 4);
+            c011 = _mm512_i32gather_ps(o3, base, 4);
+            c111 = _mm512_i32gather_ps(o3, base + 1, 4);
+        }
+        const __m512 c00 = _mm512_add_ps(c000, _mm512_mul_ps(fx, _mm512_sub_ps(c100, c000)));
+        const __m512 c10 = _mm512_add_ps(c010, _mm512_mul_ps(fx, _mm512_sub_ps(c110, c010)));
+        const __m512 c01 = _mm512_add_ps(c001, _mm512_mul_ps(fx, _mm512_sub_ps(c101, c001)));
+        const __m512 c11 = _mm512_add_ps(c011, _mm512_mul_ps(fx, _mm512_sub_ps(c111, c011)));
+        const __m512 c0 = _mm512_add_ps(c00, _mm512_mul_ps(fy, _mm512_sub_ps(c10, c00)));
+        const __m512 c1 = _mm512_add_ps(c01, _mm512_mul_ps(fy, _mm512_sub_ps(c11, c01)));
+        const __m512 v = _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
+        __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
+        u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
+        const __m512i entry = _mm512_mask_blend_epi32(valid, vzero_entry, _mm512_cvttps_epi32(u));
+        const __m512i e4 = _mm512_slli_epi32(entry, 2);
+        const __m512 cr = _mm512_i32gather_ps(e4, lut, 4);
+        const __m512 cg = _mm512_i32gather_ps(e4, lut + 1, 4);
+        const __m512 cb = _mm512_i32gather_ps(e4, lut + 2, 4);
+        const __m512 ca = _mm512_i32gather_ps(e4, lut + 3, 4);
+        const __m512 w = _mm512_sub_ps(one, aa);
+        ar = _mm512_add_ps(ar, _mm512_mul_ps(w, cr));
+        ag = _mm512_add_ps(ag, _mm512_mul_ps(w, cg));
+        ab = _mm512_add_ps(ab, _mm512_mul_ps(w, cb));
+        aa = _mm512_add_ps(aa, _mm512_mul_ps(w, ca));
+        n = _mm512_mask_add_epi32(n, valid, n, ione);
+        k = _mm512_mask_add_epi32(k, valid, k, ione);
+        const __mmask16 over =
+            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, vert, _CMP_GE_OS);
+        need = int(over & active);
+        if (need) break;
+    }
+    _mm512_store_si512(s.k, k);
+    _mm512_store_si512(s.n, n);
+    _mm512_store_ps(s.r, ar);
+    _mm512_store_ps(s.g, ag);
+    _mm512_store_ps(s.b, ab);
+    _mm512_store_ps(s.a, aa);
+    return need;
+}
+
+#endif  // LACUNA_SIMD_X86
+
+}  // namespace lacuna::simd
