@@ -50,6 +50,7 @@ import os
 import platform
 import re
 import shutil
+import signal
 import statistics
 import subprocess
 import sys
@@ -422,6 +423,8 @@ def main(argv):
     except ImportError as e:
         fail("python3-vtk9: cannot import vtk (%s); run scripts/install-deps --bench" % e)
     os.makedirs(a.out_dir, exist_ok=True)
+    # A terminated run still removes its temporary folder (the generated tree is 128 MiB).
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     tmp = tempfile.mkdtemp(prefix="lacuna-vtk-peer-")
     try:
         return run(a, tmp)
