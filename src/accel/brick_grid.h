@@ -9,7 +9,11 @@
 // TF-independent part (built once per volume): per brick of B^3 cells (B = --leaf, 8) the
 // LUT-entry range of its cells *and a one-cell apron* around them (apron_brick_ranges). Per TF:
 // one bit per brick, visible(lo, hi) by the min-max octree's opacity prefix count, packed in
-// blocks of 4x4x4 bricks per uint64 (a zero word is an empty block: the DDA's coarse level, free).
+// blocks of 4x4x4 bricks per uint64 (a zero word is an empty block: the DDA's coarse level, free),
+// and per block the Chebyshev distance (in blocks) to the nearest block with a visible brick: in
+// empty space the walk leaps out of the whole cube of empty blocks that distance guarantees
+// (Deakin & Knackstedt's distance maps, on the block grid: a few thousand entries, so the map is
+// recomputed with every TF in microseconds).
 //
 // Exactness argument. Samples are skipped only in stretches of the ray that the DDA attributes to
 // empty bricks, minus the outward rounding of for_each_lattice_run (every skipped sample lies more
@@ -23,6 +27,7 @@
 // float walk and the exact ray order differently. (Faces on the grid border are never crossed:
 // positions clamp into the border cells, which are the border brick's.)
 #pragma once
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -40,9 +45,12 @@ public:
     const int* bricks() const { return m_nb; }
     // Bit of brick (x, y, z) in its block's word.
     bool occupied(int x, int y, int z) const { return (word(x, y, z) >> bit(x, y, z)) & 1u; }
-    uint64_t word(int x, int y, int z) const {
-        return m_words[(size_t(z >> 2) * m_nw[1] + size_t(y >> 2)) * m_nw[0] + size_t(x >> 2)];
+    uint64_t word(int x, int y, int z) const { return m_words[block_index(x, y, z)]; }
+    // The block (word) holding brick (x, y, z), and its distance to the nearest occupied block.
+    size_t block_index(int x, int y, int z) const {
+        return (size_t(z >> 2) * m_nw[1] + size_t(y >> 2)) * m_nw[0] + size_t(x >> 2);
     }
+    int block_distance(int x, int y, int z) const { return m_dist[block_index(x, y, z)]; }
     static int bit(int x, int y, int z) { return (x & 3) | (y & 3) << 2 | (z & 3) << 4; }
     // Brick (x, y, z)'s apron-inclusive LUT-entry range (tests).
     void brick_range(int x, int y, int z, int& lo, int& hi) const;
@@ -63,6 +71,7 @@ public:
 
 private:
     void build();
+    void compute_distances();
     size_t slot(int x, int y, int z) const {
         return ((size_t(z >> 2) * m_nw[1] + size_t(y >> 2)) * m_nw[0] + size_t(x >> 2)) * 64 +
                size_t(bit(x, y, z));
@@ -81,6 +90,7 @@ private:
     // Apron ranges in block order (slot()); bricks past the grid hold the empty range {1, 0}.
     std::vector<uint16_t> m_lo, m_hi;
     std::vector<uint64_t> m_words;
+    std::vector<uint8_t> m_dist;  // per block: Chebyshev distance to an occupied block, 1..255
     OpacityPrefix m_prefix;
 };
 
@@ -102,6 +112,13 @@ public:
             m_inv[a] = r.d[a] == 0.f ? 0.f : 1.f / r.d[a];
             m_cells[a] = g.m_pyr.cells[a];
             m_nbm1[a] = g.m_nb[a] - 1;
+            // Branch-free brick crossings: the exit plane of brick n is (n + m_up) << L, and it
+            // is the border (never crossed: +inf) when it is <= m_lo_lim or >= m_hi_lim.
+            const bool up = r.d[a] > 0.f, down = r.d[a] < 0.f;
+            m_up[a] = up ? 1 : 0;
+            m_step[a] = up ? 1 : -1;
+            m_lo_lim[a] = up ? INT32_MIN : (down ? 0 : INT32_MAX);
+            m_hi_lim[a] = up ? m_cells[a] : INT32_MAX;
             float p = m_o[a] + t_near * m_d[a];
             p = p < 0.f ? 0.f : (p > float(m_cells[a]) ? float(m_cells[a]) : p);
             m_b[a] = std::min(int(p) >> L, m_nbm1[a]);
@@ -109,43 +126,54 @@ public:
         for (int a = 0; a < 3; ++a) m_next[a] = crossing(a, m_b[a], L);
     }
 
-    // One step of the walk: the stretch [t0, t1] of the ray in brick b (coarse: in the empty
-    // 4x4x4 block holding brick b). False once the ray is done.
+    // One step of the walk: the stretch [t0, t1] of the ray in the bricks lo..hi (inclusive):
+    // one brick, or for a leap the cube of empty blocks around the ray's block. False once the
+    // ray is done.
     struct Step {
         float t0, t1;
-        int b[3];
+        int lo[3], hi[3];
         bool occupied, coarse;
     };
     bool step(Step& s) {
         if (!(m_t < m_far)) return false;
         const int L = m_g.m_log2;
-        const uint64_t w = m_g.word(m_b[0], m_b[1], m_b[2]);
+        const size_t blk = m_g.block_index(m_b[0], m_b[1], m_b[2]);
+        const uint64_t w = m_g.m_words[blk];
         int a;
         float t_exit;
         s.coarse = w == 0;
         if (s.coarse) {
-            // The whole block is empty: leave it through its nearest face.
+            // Every block within Chebyshev distance r - 1 of this one is empty: leave that cube
+            // through its nearest face.
+            const int r = m_g.m_dist[blk];
+            int lo[3], hi[3];
             float tb[3];
-            for (int c = 0; c < 3; ++c) tb[c] = crossing(c, m_b[c] >> 2, L + 2);
+            for (int c = 0; c < 3; ++c) {
+                const int B = m_b[c] >> 2;
+                lo[c] = B - r + 1;
+                hi[c] = B + r;  // exclusive, in blocks
+                tb[c] = leap_crossing(c, lo[c], hi[c], L + 2);
+                s.lo[c] = std::max(0, lo[c] << 2);
+                s.hi[c] = std::min(m_nbm1[c], (hi[c] << 2) - 1);
+            }
             a = argmin(tb);
             t_exit = tb[a];
             s.occupied = false;
-        } else {
-            a = argmin(m_next);
-            t_exit = m_next[a];
-            s.occupied = (w >> bit(m_b[0], m_b[1], m_b[2])) & 1u;
+            s.t0 = m_t;
+            s.t1 = std::max(std::min(t_exit, m_far), m_t);
+            m_t = s.t1;
+            reseed(a, s.lo, s.hi, L);
+            return true;
         }
+        a = argmin(m_next);
+        t_exit = m_next[a];
+        s.occupied = (w >> bit(m_b[0], m_b[1], m_b[2])) & 1u;
         s.t0 = m_t;
         s.t1 = std::max(std::min(t_exit, m_far), m_t);
-        for (int c = 0; c < 3; ++c) s.b[c] = m_b[c];
-        // Advance to the next brick (or block).
+        for (int c = 0; c < 3; ++c) s.lo[c] = s.hi[c] = m_b[c];
         m_t = s.t1;
-        if (s.coarse) {
-            reseed(a, L);
-        } else {
-            m_b[a] += m_d[a] > 0.f ? 1 : -1;
-            m_next[a] = crossing(a, m_b[a], L);
-        }
+        m_b[a] += m_step[a];
+        m_next[a] = crossing(a, m_b[a], L);
         return true;
     }
 
@@ -188,34 +216,40 @@ private:
     // Parameter at which the ray leaves node `n` (edge 2^shift cells) on axis a; +inf if it
     // never does (parallel ray, or the face is the grid border).
     float crossing(int a, int n, int shift) const {
+        const int plane = (n + m_up[a]) << shift;
+        const float t = (float(plane) - m_o[a]) * m_inv[a];
+        return plane <= m_lo_lim[a] || plane >= m_hi_lim[a] ? INFINITY : t;
+    }
+    // Parameter at which the ray leaves the slab of nodes [lo, hi) (edge 2^shift cells) on axis
+    // a; +inf if it never does (parallel ray, or the face is on or past the grid border).
+    float leap_crossing(int a, int lo, int hi, int shift) const {
         if (m_d[a] > 0.f) {
-            const int plane = (n + 1) << shift;
+            const int64_t plane = int64_t(hi) << shift;
             return plane >= m_cells[a] ? INFINITY : (float(plane) - m_o[a]) * m_inv[a];
         }
         if (m_d[a] < 0.f) {
-            const int plane = n << shift;
+            const int64_t plane = int64_t(lo) << shift;
             return plane <= 0 ? INFINITY : (float(plane) - m_o[a]) * m_inv[a];
         }
         return INFINITY;
     }
-    // After a coarse step across axis a's block face at m_t: the first brick of the next block
-    // on a; the other axes from the position at m_t, kept inside the block they were in.
-    void reseed(int a, int L) {
-        const int blk_a = m_b[a] >> 2;
+    // After a leap out of the brick box lo..hi across axis a's face at m_t: the brick past the
+    // face on a; the other axes from the position at m_t, kept inside the box.
+    void reseed(int a, const int lo[3], const int hi[3], int L) {
         for (int c = 0; c < 3; ++c) {
             if (c == a) continue;
             float p = m_o[c] + m_t * m_d[c];
             p = p < 0.f ? 0.f : (p > float(m_cells[c]) ? float(m_cells[c]) : p);
-            const int lo = (m_b[c] >> 2) << 2, hi = std::min(lo + 3, m_nbm1[c]);
-            m_b[c] = std::clamp(int(p) >> L, lo, hi);
+            m_b[c] = std::clamp(int(p) >> L, lo[c], hi[c]);
         }
-        m_b[a] = m_d[a] > 0.f ? (blk_a + 1) << 2 : (blk_a << 2) - 1;
+        m_b[a] = m_d[a] > 0.f ? hi[a] + 1 : lo[a] - 1;
         for (int c = 0; c < 3; ++c) m_next[c] = crossing(c, m_b[c], L);
     }
 
     const BrickGrid& m_g;
     float m_o[3], m_d[3], m_inv[3];
     int m_cells[3], m_nbm1[3];
+    int m_up[3], m_step[3], m_lo_lim[3], m_hi_lim[3];
     int m_b[3];
     float m_next[3];
     float m_t, m_far, m_min_skip, m_chunk;

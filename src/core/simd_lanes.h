@@ -73,11 +73,14 @@ struct LaneGrid {
 
 // ---- SSE4.1: four lanes (the baseline) -------------------------------------------------------
 #if defined(__SSE4_1__)
-// Marches every active lane until one of them needs the scheduler: its run ended (k == kend) or
-// it turned opaque (a >= ert). Returns that lane mask (bit l = lane l). `lut` holds RGBA entries
-// (premultiplied, step-corrected), entry zero_entry all zero.
-template <class T>
-inline int march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float* lut) {
+// Marches the active lanes. When some need the scheduler (their run ended: k == kend, or they
+// turned opaque: a >= ert), the state goes back to `s`, refill(mask) (bit l = lane l) updates
+// those lanes and returns whether any lane is still active, and marching resumes with the
+// state reloaded. `lut` holds RGBA entries (premultiplied, step-corrected), entry zero_entry all
+// zero. The same contract for every width below.
+template <class T, class Refill>
+inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                         Refill& refill) {
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.f);
     const __m128 vdt = _mm_set1_ps(g.dt), vert = _mm_set1_ps(g.ert);
     const __m128 vhi[3] = {_mm_set1_ps(g.hi[0]), _mm_set1_ps(g.hi[1]), _mm_set1_ps(g.hi[2])};
@@ -87,15 +90,18 @@ inline int march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float*
     const __m128 voff = _mm_set1_ps(g.lut_offset), vscale = _mm_set1_ps(g.lut_scale),
                  vlast = _mm_set1_ps(g.lut_last);
     const __m128i vzero_entry = _mm_set1_epi32(g.zero_entry);
-    const __m128 o[3] = {_mm_load_ps(s.ox), _mm_load_ps(s.oy), _mm_load_ps(s.oz)};
-    const __m128 d[3] = {_mm_load_ps(s.dx), _mm_load_ps(s.dy), _mm_load_ps(s.dz)};
-    const __m128 tb = _mm_load_ps(s.t_base);
-    const __m128i kend = _mm_load_si128(reinterpret_cast<const __m128i*>(s.kend));
-    const __m128i active = _mm_load_si128(reinterpret_cast<const __m128i*>(s.active));
-    __m128i k = _mm_load_si128(reinterpret_cast<const __m128i*>(s.k));
-    __m128i n = _mm_load_si128(reinterpret_cast<const __m128i*>(s.n));
-    __m128 ar = _mm_load_ps(s.r), ag = _mm_load_ps(s.g), ab = _mm_load_ps(s.b),
-           aa = _mm_load_ps(s.a);
+    __m128 o[3], d[3], tb, ar, ag, ab, aa;
+    __m128i kend, active, k, n;
+#define LACUNA_LOAD_LANES                                                   \
+    o[0] = _mm_load_ps(s.ox), o[1] = _mm_load_ps(s.oy), o[2] = _mm_load_ps(s.oz); \
+    d[0] = _mm_load_ps(s.dx), d[1] = _mm_load_ps(s.dy), d[2] = _mm_load_ps(s.dz); \
+    tb = _mm_load_ps(s.t_base);                                             \
+    kend = _mm_load_si128(reinterpret_cast<const __m128i*>(s.kend));        \
+    active = _mm_load_si128(reinterpret_cast<const __m128i*>(s.active));    \
+    k = _mm_load_si128(reinterpret_cast<const __m128i*>(s.k));              \
+    n = _mm_load_si128(reinterpret_cast<const __m128i*>(s.n));              \
+    ar = _mm_load_ps(s.r), ag = _mm_load_ps(s.g), ab = _mm_load_ps(s.b), aa = _mm_load_ps(s.a);
+    LACUNA_LOAD_LANES
     const ptrdiff_t sy = g.sy, sz = g.sz, syz = ptrdiff_t(g.sy) + g.sz;
     int need;
     for (;;) {
@@ -215,15 +221,18 @@ inline int march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float*
         const __m128i over = _mm_or_si128(_mm_cmpeq_epi32(k, kend),
                                           _mm_castps_si128(_mm_cmpge_ps(aa, vert)));
         need = _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(over, active)));
-        if (need) break;
+        if (need) {
+            _mm_store_si128(reinterpret_cast<__m128i*>(s.k), k);
+            _mm_store_si128(reinterpret_cast<__m128i*>(s.n), n);
+            _mm_store_ps(s.r, ar);
+            _mm_store_ps(s.g, ag);
+            _mm_store_ps(s.b, ab);
+            _mm_store_ps(s.a, aa);
+            if (!refill(need)) return;
+            LACUNA_LOAD_LANES
+        }
     }
-    _mm_store_si128(reinterpret_cast<__m128i*>(s.k), k);
-    _mm_store_si128(reinterpret_cast<__m128i*>(s.n), n);
-    _mm_store_ps(s.r, ar);
-    _mm_store_ps(s.g, ag);
-    _mm_store_ps(s.b, ab);
-    _mm_store_ps(s.a, aa);
-    return need;
+#undef LACUNA_LOAD_LANES
 }
 
 #endif
@@ -231,8 +240,9 @@ inline int march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float*
 // ---- AVX2: eight lanes ---------------------------------------------------------------------
 #define LACUNA_AVX2 __attribute__((target("avx2")))
 
-template <class T>
-LACUNA_AVX2 int march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut) {
+template <class T, class Refill>
+LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                              Refill& refill) {
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.f);
     const __m256 vdt = _mm256_set1_ps(g.dt), vert = _mm256_set1_ps(g.ert);
     const __m256 vhi0 = _mm256_set1_ps(g.hi[0]), vhi1 = _mm256_set1_ps(g.hi[1]),
@@ -243,15 +253,19 @@ LACUNA_AVX2 int march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const f
     const __m256 voff = _mm256_set1_ps(g.lut_offset), vscale = _mm256_set1_ps(g.lut_scale),
                  vlast = _mm256_set1_ps(g.lut_last);
     const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
-    const __m256 ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz);
-    const __m256 dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz);
-    const __m256 tb = _mm256_load_ps(s.t_base);
-    const __m256i kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));
-    const __m256i active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));
-    __m256i k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));
-    __m256i n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));
-    __m256 ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b),
-           aa = _mm256_load_ps(s.a);
+    __m256 ox, oy, oz, dx, dy, dz, tb, ar, ag, ab, aa;
+    __m256i kend, active, k, n;
+#define LACUNA_LOAD_LANES                                                             \
+    ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz);  \
+    dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz);  \
+    tb = _mm256_load_ps(s.t_base);                                                    \
+    kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));               \
+    active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));           \
+    k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));                     \
+    n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
+    ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);     \
+    aa = _mm256_load_ps(s.a);
+    LACUNA_LOAD_LANES
     // Gather offsets of the corner pairs (in elements): 0, sy, sz, sy + sz. For uint8 a 32-bit
     // gather reads 4 bytes; the pairs past the first are read from 2 bytes before them (bytes 2
     // and 3 of the word) so no read passes the last voxel, and the first from its own offset.
@@ -361,22 +375,26 @@ LACUNA_AVX2 int march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const f
         const __m256i over = _mm256_or_si256(
             _mm256_cmpeq_epi32(k, kend), _mm256_castps_si256(_mm256_cmp_ps(aa, vert, _CMP_GE_OS)));
         need = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(over, active)));
-        if (need) break;
+        if (need) {
+            _mm256_store_si256(reinterpret_cast<__m256i*>(s.k), k);
+            _mm256_store_si256(reinterpret_cast<__m256i*>(s.n), n);
+            _mm256_store_ps(s.r, ar);
+            _mm256_store_ps(s.g, ag);
+            _mm256_store_ps(s.b, ab);
+            _mm256_store_ps(s.a, aa);
+            if (!refill(need)) return;
+            LACUNA_LOAD_LANES
+        }
     }
-    _mm256_store_si256(reinterpret_cast<__m256i*>(s.k), k);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(s.n), n);
-    _mm256_store_ps(s.r, ar);
-    _mm256_store_ps(s.g, ag);
-    _mm256_store_ps(s.b, ab);
-    _mm256_store_ps(s.a, aa);
-    return need;
+#undef LACUNA_LOAD_LANES
 }
 
 // ---- AVX-512: sixteen lanes ------------------------------------------------------------------
 #define LACUNA_AVX512 __attribute__((target("avx512f")))
 
-template <class T>
-LACUNA_AVX512 int march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut) {
+template <class T, class Refill>
+LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                                Refill& refill) {
     const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
     const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
     const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
@@ -387,16 +405,20 @@ LACUNA_AVX512 int march_lanes16(Lanes& s, const LaneGrid& g, const T* data, cons
     const __m512 voff = _mm512_set1_ps(g.lut_offset), vscale = _mm512_set1_ps(g.lut_scale),
                  vlast = _mm512_set1_ps(g.lut_last);
     const __m512i vzero_entry = _mm512_set1_epi32(g.zero_entry), ione = _mm512_set1_epi32(1);
-    const __m512 ox = _mm512_load_ps(s.ox), oy = _mm512_load_ps(s.oy), oz = _mm512_load_ps(s.oz);
-    const __m512 dx = _mm512_load_ps(s.dx), dy = _mm512_load_ps(s.dy), dz = _mm512_load_ps(s.dz);
-    const __m512 tb = _mm512_load_ps(s.t_base);
-    const __m512i kend = _mm512_load_si512(s.kend);
-    const __mmask16 active =
-        _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active), _mm512_setzero_si512());
-    __m512i k = _mm512_load_si512(s.k);
-    __m512i n = _mm512_load_si512(s.n);
-    __m512 ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b),
-           aa = _mm512_load_ps(s.a);
+    __m512 ox, oy, oz, dx, dy, dz, tb, ar, ag, ab, aa;
+    __m512i kend, k, n;
+    __mmask16 active;
+#define LACUNA_LOAD_LANES                                                                   \
+    ox = _mm512_load_ps(s.ox), oy = _mm512_load_ps(s.oy), oz = _mm512_load_ps(s.oz);        \
+    dx = _mm512_load_ps(s.dx), dy = _mm512_load_ps(s.dy), dz = _mm512_load_ps(s.dz);        \
+    tb = _mm512_load_ps(s.t_base);                                                          \
+    kend = _mm512_load_si512(s.kend);                                                       \
+    active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active), _mm512_setzero_si512()); \
+    k = _mm512_load_si512(s.k);                                                             \
+    n = _mm512_load_si512(s.n);                                                             \
+    ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b);           \
+    aa = _mm512_load_ps(s.a);
+    LACUNA_LOAD_LANES
     constexpr bool kByte = sizeof(T) == 1;
     const __m512i q1 = _mm512_set1_epi32(kByte ? g.sy - 2 : g.sy);
     const __m512i q2 = _mm512_set1_epi32(kByte ? g.sz - 2 : g.sz);
@@ -499,15 +521,18 @@ LACUNA_AVX512 int march_lanes16(Lanes& s, const LaneGrid& g, const T* data, cons
         const __mmask16 over =
             _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, vert, _CMP_GE_OS);
         need = int(over & active);
-        if (need) break;
+        if (need) {
+            _mm512_store_si512(s.k, k);
+            _mm512_store_si512(s.n, n);
+            _mm512_store_ps(s.r, ar);
+            _mm512_store_ps(s.g, ag);
+            _mm512_store_ps(s.b, ab);
+            _mm512_store_ps(s.a, aa);
+            if (!refill(need)) return;
+            LACUNA_LOAD_LANES
+        }
     }
-    _mm512_store_si512(s.k, k);
-    _mm512_store_si512(s.n, n);
-    _mm512_store_ps(s.r, ar);
-    _mm512_store_ps(s.g, ag);
-    _mm512_store_ps(s.b, ab);
-    _mm512_store_ps(s.a, aa);
-    return need;
+#undef LACUNA_LOAD_LANES
 }
 
 #endif  // LACUNA_SIMD_X86

@@ -132,7 +132,7 @@ template <int W, class T, class S, class March>
 void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const Camera& cam,
                        const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
                        int x0, int y0, int x1, int y1, RenderResult& out,
-                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March march) {
+                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March&& march) {
     using Cursor = typename S::Cursor;
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
     const Vec3f inv_sp = inverse_spacing(vol);
@@ -192,10 +192,8 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
         L.active[l] = 0;
         L.k[l] = L.kend[l] = 0;
     };
-    for (int l = 0; l < W; ++l) start(l);
-    const float* table = &lut[0].r;
-    while (live > 0) {
-        const int need = march(L, lg, data, table);
+    // The lanes that need it: the ray's next run, or its pixel and the tile's next ray.
+    auto refill = [&](int need) {
         for (int l = 0; l < W; ++l) {
             if (!(need >> l & 1)) continue;
             int kb, ke;
@@ -209,7 +207,10 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
             --live;
             start(l);
         }
-    }
+        return live > 0;
+    };
+    for (int l = 0; l < W; ++l) start(l);
+    if (live > 0) march(L, lg, data, &lut[0].r, refill);
     samples += tile_samples;
     rays += tile_rays;
 }
@@ -230,16 +231,19 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
 #if LACUNA_SIMD_X86
         case simd::Isa::Avx512:
             render_tile_lanes<16>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                  samples, rays, &simd::march_lanes16<T>);
+                                  samples, rays,
+                                  [](auto&&... a) { simd::march_lanes16<T>(a...); });
             return;
         case simd::Isa::Avx2:
             render_tile_lanes<8>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                 samples, rays, &simd::march_lanes8<T>);
+                                 samples, rays,
+                                  [](auto&&... a) { simd::march_lanes8<T>(a...); });
             return;
 #if defined(__SSE4_1__)
         case simd::Isa::Sse41:
             render_tile_lanes<4>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                 samples, rays, &simd::march_lanes4<T>);
+                                 samples, rays,
+                                  [](auto&&... a) { simd::march_lanes4<T>(a...); });
             return;
 #endif
 #endif

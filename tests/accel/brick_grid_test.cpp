@@ -90,6 +90,49 @@ TEST(BrickGrid, BitsAreThePrefixCountOfTheRangesAndBricksPastTheGridAreEmpty) {
     }
 }
 
+// Zero everywhere but a few random voxels: empty blocks to leap over.
+Volume sparse_volume(VoxelType t, Vec3i dims, Rng& rng) {
+    Volume v(dims, t);
+    float lo, hi;
+    type_limits(t, lo, hi);
+    const int points = rng.range(1, 6);
+    for (int p = 0; p < points; ++p)
+        v.set_value(rng.range(0, dims.x - 1), rng.range(0, dims.y - 1), rng.range(0, dims.z - 1),
+                    random_value(t, lo, hi, rng));
+    v.set_value(0, 0, 0, random_value(t, lo, hi, rng));
+    v.compute_range();
+    return v;
+}
+
+TEST(BrickGrid, BlockDistancesAreTheChebyshevDistanceToTheNearestOccupiedBlock) {
+    Rng rng{9105};
+    for (int trial = 0; trial < 20; ++trial) {
+        const Volume v = sparse_volume(kAllTypes[trial % 4], random_dims(rng, 2, 120), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 2);
+        BrickGrid g(v, o);
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        g.set_transfer_function(trial % 5 == 4 ? empty_lut(v.vis_range())
+                                               : random_lut(v.vis_range(), kDefaultLutSize, rng,
+                                                            voxel_entries(v, m, rng, 2)));
+        const int* nb = g.bricks();
+        const int nw[3] = {(nb[0] + 3) / 4, (nb[1] + 3) / 4, (nb[2] + 3) / 4};
+        for (int z = 0; z < nw[2]; ++z)
+            for (int y = 0; y < nw[1]; ++y)
+                for (int x = 0; x < nw[0]; ++x) {
+                    int want = 255;
+                    for (int c = 0; c < nw[2]; ++c)
+                        for (int b = 0; b < nw[1]; ++b)
+                            for (int a = 0; a < nw[0]; ++a)
+                                if (g.word(4 * a, 4 * b, 4 * c))
+                                    want = std::min(want, std::max({std::abs(a - x), std::abs(b - y),
+                                                                    std::abs(c - z)}));
+                    ASSERT_EQ(g.block_distance(4 * x, 4 * y, 4 * z), std::max(want, 1))
+                        << "block " << x << "," << y << "," << z;
+                }
+    }
+}
+
 // A ray through two points of the box that lie on brick corners, edges or faces (or anywhere),
 // starting outside it; t scaled anisotropically. False if it misses the box.
 bool corner_ray(const float hi[3], int B, Rng& rng, kernel::IndexRay& r, float& t_near,
@@ -119,10 +162,11 @@ bool corner_ray(const float hi[3], int B, Rng& rng, kernel::IndexRay& r, float& 
 // than one voxel of that step's brick (or block), so its cell is in the brick's apron.
 TEST(BrickGrid, WalkStepsTileTheRayAndHoldTheMarchersSamplePositions) {
     Rng rng{9104};
-    int samples = 0, coarse = 0;
+    int samples = 0, coarse = 0, leaps = 0;
     float worst = 0.f;
     for (int trial = 0; trial < 30; ++trial) {
-        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
+        const Volume v = trial % 2 ? sparse_volume(kAllTypes[trial % 4], random_dims(rng, 6, 90), rng)
+                                   : random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
         AccelOptions o;
         o.leaf_cells = 2 << rng.range(0, 2);
         BrickGrid g(v, o);
@@ -147,20 +191,27 @@ TEST(BrickGrid, WalkStepsTileTheRayAndHoldTheMarchersSamplePositions) {
                 ASSERT_EQ(st.t0, t_prev) << "steps must tile the ray";
                 ASSERT_LE(st.t0, st.t1);
                 t_prev = st.t1;
-                const int shift = g.brick_log2() + (st.coarse ? 2 : 0);
                 coarse += st.coarse;
-                if (st.coarse) {
-                    for (int a = 0; a < 3; ++a) ASSERT_LT(st.b[a], g.bricks()[a]);
-                    ASSERT_EQ(g.word(st.b[0], st.b[1], st.b[2]), 0u);
+                for (int a = 0; a < 3; ++a) {
+                    ASSERT_LE(0, st.lo[a]);
+                    ASSERT_LE(st.lo[a], st.hi[a]);
+                    ASSERT_LT(st.hi[a], g.bricks()[a]);
                 }
+                if (st.coarse)  // a leap crosses only empty bricks
+                    for (int z = st.lo[2]; z <= st.hi[2]; ++z)
+                        for (int y = st.lo[1]; y <= st.hi[1]; ++y)
+                            for (int x = st.lo[0]; x <= st.hi[0]; ++x)
+                                ASSERT_FALSE(g.occupied(x, y, z)) << "leap over a visible brick";
+                leaps += st.coarse && (st.hi[0] - st.lo[0] > 3 || st.hi[1] - st.lo[1] > 3 ||
+                                       st.hi[2] - st.lo[2] > 3);
                 for (; k < k_end; ++k) {
                     const float t = t_near + (float(k) + 0.5f) * dt;
                     if (t > st.t1) break;
                     float p[3] = {r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz};
                     for (int a = 0; a < 3; ++a) {
                         p[a] = p[a] < 0.f ? 0.f : (p[a] > hi[a] ? hi[a] : p[a]);
-                        const float lo = float((st.b[a] >> (shift - g.brick_log2())) << shift);
-                        const float up = std::min(hi[a], lo + float(1 << shift));
+                        const float lo = float(st.lo[a] * B);
+                        const float up = std::min(hi[a], float((st.hi[a] + 1) * B));
                         const float out = std::max(lo - p[a], p[a] - up);
                         worst = std::max(worst, out);
                         ASSERT_LT(out, 1e-3f) << "sample " << k << " at t " << t << " is "
@@ -176,6 +227,7 @@ TEST(BrickGrid, WalkStepsTileTheRayAndHoldTheMarchersSamplePositions) {
     }
     EXPECT_GT(samples, 50000);
     EXPECT_GT(coarse, 100) << "the cases must take coarse steps";
+    EXPECT_GT(leaps, 20) << "the cases must leap over more than one block";
     std::printf("worst excursion of a sample outside its step's box: %.3g voxels\n", worst);
 }
 
