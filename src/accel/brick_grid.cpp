@@ -33,6 +33,14 @@ void BrickGrid::build() {
             }
     m_words.assign(words, 0);
     m_dist.assign(words, 1);
+    m_block_lo.assign(words, 1);
+    m_block_hi.assign(words, 0);
+    for (size_t w = 0; w < words; ++w)
+        for (int b = 0; b < 64; ++b)
+            if (m_lo[w * 64 + b] <= m_hi[w * 64 + b]) {
+                m_block_lo[w] = std::min(m_block_lo[w], m_lo[w * 64 + b]);
+                m_block_hi[w] = std::max(m_block_hi[w], m_hi[w * 64 + b]);
+            }
     m_stats.build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     m_stats.nodes = size_t(m_nb[0]) * m_nb[1] * m_nb[2];
@@ -67,9 +75,13 @@ void BrickGrid::compute_distances() {
         out.resize(size_t(n));
         for (int i = 0; i < n; ++i) line[size_t(i)] = cell(i);
         for (int i = 0; i < n; ++i) {
+            // Outward from i: a q at distance >= best cannot improve on best.
             int best = line[size_t(i)];
-            for (int q = 0; q < n && best > 0; ++q)
-                best = std::min(best, std::max(std::abs(i - q), line[size_t(q)]));
+            for (int d = 1; d < best; ++d) {
+                if (i - d >= 0) best = std::min(best, std::max(d, line[size_t(i - d)]));
+                if (i + d < n) best = std::min(best, std::max(d, line[size_t(i + d)]));
+                if (i - d < 0 && i + d >= n) break;
+            }
             out[size_t(i)] = best;
         }
         for (int i = 0; i < n; ++i) cell(i) = out[size_t(i)];
@@ -91,16 +103,37 @@ void BrickGrid::set_transfer_function(const TransferLut& lut) {
     const auto t0 = std::chrono::steady_clock::now();
     if (needs_rebuild(lut)) build();
     m_prefix.build(lut);
-    // One word per block: 64 prefix-count tests, no branches.
+    // The prefix count as one lookup: a range [lo, hi] holds a visible entry iff the first
+    // visible entry at or after lo is <= hi. (Empty bricks past the grid: lo = 1 > hi = 0.)
+    const int size = lut.size();
+    m_next_visible.resize(size_t(size) + 1);
+    m_next_visible[size_t(size)] = uint16_t(0xffff);
+    for (int e = size - 1; e >= 0; --e)
+        m_next_visible[size_t(e)] =
+            lut.entries[size_t(e)].a > 0.f ? uint16_t(e) : m_next_visible[size_t(e) + 1];
+    // One word per block, 64 branch-free tests; two threads on big grids.
     const size_t n = m_words.size();
     const uint16_t* lo = m_lo.data();
     const uint16_t* hi = m_hi.data();
-    for (size_t w = 0; w < n; ++w) {
-        uint64_t bits = 0;
-        for (int b = 0; b < 64; ++b)
-            bits |= uint64_t(m_prefix.visible(lo[w * 64 + b], hi[w * 64 + b])) << b;
-        m_words[w] = bits;
-    }
+    const uint16_t* next = m_next_visible.data();
+    auto words = [&](size_t w0, size_t w1) {
+        for (size_t w = w0; w < w1; ++w) {
+            // Most blocks of sparse data are decided by their union range alone.
+            if (next[m_block_lo[w]] > m_block_hi[w]) {
+                m_words[w] = 0;
+                continue;
+            }
+            uint64_t bits = 0;
+            const uint16_t* l = lo + w * 64;
+            const uint16_t* h = hi + w * 64;
+            for (int b = 0; b < 64; ++b) bits |= uint64_t(next[l[b]] <= h[b]) << b;
+            m_words[w] = bits;
+        }
+    };
+    if (n >= 2048)
+        parallel_for(n, m_opts.threads, words, 512);
+    else
+        words(0, n);
     compute_distances();
     m_stats.tf_update_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

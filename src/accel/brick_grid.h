@@ -90,8 +90,10 @@ private:
     // Apron ranges in block order (slot()); bricks past the grid hold the empty range {1, 0}.
     std::vector<uint16_t> m_lo, m_hi;
     std::vector<uint64_t> m_words;
+    std::vector<uint16_t> m_block_lo, m_block_hi;  // per block: union of its bricks' ranges
     std::vector<uint8_t> m_dist;  // per block: Chebyshev distance to an occupied block, 1..255
     OpacityPrefix m_prefix;
+    std::vector<uint16_t> m_next_visible;  // per LUT entry: the first visible entry >= it
 };
 
 // Front-to-back walk of one ray through the grid; hands out the stretches that may hold visible

@@ -325,8 +325,16 @@ void apron_typed(const Volume& v, const T* data, ValueToLut map, int edge, int t
                         first = false;
                         continue;
                     }
-                    for (int i = 0; i < d.x; ++i) a[i] = std::min(a[i], lo_row[i]);
-                    for (int i = 0; i < d.x; ++i) b[i] = std::max(b[i], hi_row[i]);
+                    if constexpr (kRaw) {
+                        for (int i = 0; i < d.x; ++i) {
+                            const V x = row[i];
+                            a[i] = std::min(a[i], x);
+                            b[i] = std::max(b[i], x);
+                        }
+                    } else {
+                        for (int i = 0; i < d.x; ++i) a[i] = std::min(a[i], lo_row[i]);
+                        for (int i = 0; i < d.x; ++i) b[i] = std::max(b[i], hi_row[i]);
+                    }
                 }
             const size_t base = (size_t(bz) * nb[1] + by) * nb[0];
             for (int bx = 0; bx < nb[0]; ++bx) {
