@@ -128,6 +128,8 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
 // lane whose run ends pulls the ray's next run from its cursor; a lane whose ray is done (no runs
 // left, or opaque) writes its pixel and takes the tile's next ray. `march` runs the lanes until
 // one needs the scheduler and returns that lane mask.
+constexpr int kMaxTilePixels = 64 * 64;
+
 template <int W, class T, class S, class March>
 void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const Camera& cam,
                        const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
@@ -156,14 +158,28 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
     };
     simd::Lanes L{};
     Slot slot[W];
-    const int w = x1 - x0, npix = w * (y1 - y0);
+    // Rays enter the lanes in 4x4 pixel blocks, not rows: the lanes' sample positions then
+    // stay in a compact tube of voxels, so the cache lines one block loads serve its neighbours.
+    const int w = x1 - x0, h = y1 - y0, npix = w * h;
+    int order[kMaxTilePixels][2];
+    {
+        int q = 0;
+        for (int by = 0; by < h; by += 4)
+            for (int bx = 0; bx < w; bx += 4)
+                for (int y = by; y < std::min(by + 4, h); ++y)
+                    for (int x = bx; x < std::min(bx + 4, w); ++x) {
+                        order[q][0] = x0 + x;
+                        order[q][1] = y0 + y;
+                        ++q;
+                    }
+    }
     int next_pixel = 0, live = 0;
     uint64_t tile_samples = 0, tile_rays = 0;
     // Puts the tile's next ray with at least one run into lane l (pixels without one are written
     // on the way); idles the lane when the tile has no rays left.
     auto start = [&](int l) {
         while (next_pixel < npix) {
-            const int x = x0 + next_pixel % w, y = y0 + next_pixel / w;
+            const int x = order[next_pixel][0], y = order[next_pixel][1];
             ++next_pixel;
             const kernel::IndexRay r = index_ray(cam.generate(float(x), float(y)), inv_sp);
             float t_near, t_far;
@@ -222,7 +238,7 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                     const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
                     ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
                     std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
-    if (!small) {
+    if (!small || (x1 - x0) * (y1 - y0) > kMaxTilePixels) {
         render_tile<T, int64_t>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                 samples, rays);
         return;
