@@ -25,6 +25,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include "accel/cursor.h"
 #include "render/pixel_driver.h"
@@ -34,6 +35,7 @@
 #include "lacuna/camera.h"
 #include "lacuna/image.h"
 #include "lacuna/renderer.h"
+#include "core/simd_shading.h"
 #include "render/ray_march_kernel.h"
 #include "render/shading.h"
 
@@ -282,6 +284,219 @@ inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g,
     return n;
 }
 
+// ---- The batched composite ray (the SIMD paths; composite_ray above is the reference) --------
+//
+// The samples of composite_ray, kShadeBatch at a time across the cursor's runs (as
+// kernel::RayStream queues them): (1) positions from k, and the trilinear values of the whole
+// batch in SIMD lanes; (2) per sample, in order, the clip test, the side and the TF entry, and
+// the samples with non-zero opacity collected; (3) the gradients of those, in SIMD lanes; (4) in
+// k order, shading and front-to-back compositing up to early termination. Every quantity is the
+// one composite_ray computes for the same sample, with the same operations (core/simd_shading.h
+// for the lanes; for head and directional lights the half vector once per ray, by the function
+// phong() and pbr() call per sample), and the composited samples and their order are the same,
+// so the bits are the same. Work past the terminating sample (values and gradients of the rest
+// of its batch) is discarded, never composited or counted. Shadows stay on composite_ray.
+inline constexpr int kShadeBatch = 8;
+
+// Lane operations of one ISA path over kShadeBatch positions: trilinear values, on-the-fly
+// gradients, gradient-volume lookups. W = 4: SSE4.1 (two calls), W = 8: AVX2 (also the path
+// for AVX-512 CPUs: a batch is 8 samples).
+template <int W>
+struct ShadeOps;
+#if LACUNA_SIMD_X86 && defined(__SSE4_1__)
+template <>
+struct ShadeOps<4> {
+    // mask: bit l = slot l needs its gradient; a half without any is not computed.
+    template <class T>
+    static void samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
+                        const int32_t* k, float* x, float* y, float* z, float* v, int n) {
+        for (int l = 0; l < n; l += 4) simd::samples4(g, r, d, k + l, x + l, y + l, z + l, v + l);
+    }
+    template <class T>
+    static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
+                          const float* z, float* gx, float* gy, float* gz, unsigned mask) {
+        for (int l = 0; l < kShadeBatch; l += 4)
+            if (mask >> l & 15u) simd::gradients4(g, d, x + l, y + l, z + l, gx + l, gy + l, gz + l);
+    }
+    static void volume_gradients(const simd::ShadeGrid& g, const float* const grad[3],
+                                 const float* x, const float* y, const float* z, float* gx,
+                                 float* gy, float* gz, unsigned mask) {
+        for (int l = 0; l < kShadeBatch; l += 4)
+            if (mask >> l & 15u)
+                simd::volume_gradients4(g, grad, x + l, y + l, z + l, gx + l, gy + l, gz + l);
+    }
+};
+#endif
+#if LACUNA_SIMD_X86
+template <>
+struct ShadeOps<8> {
+    template <class T>
+    static void samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
+                        const int32_t* k, float* x, float* y, float* z, float* v, int) {
+        simd::samples8(g, r, d, k, x, y, z, v);
+    }
+    template <class T>
+    static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
+                          const float* z, float* gx, float* gy, float* gz, unsigned) {
+        simd::gradients8(g, d, x, y, z, gx, gy, gz);
+    }
+    static void volume_gradients(const simd::ShadeGrid& g, const float* const grad[3],
+                                 const float* x, const float* y, const float* z, float* gx,
+                                 float* gy, float* gz, unsigned) {
+        simd::volume_gradients8(g, grad, x, y, z, gx, gy, gz);
+    }
+};
+#endif
+
+inline simd::ShadeGrid shade_grid(const Context& c, const int dims[3]) {
+    return {{float(dims[0] - 1), float(dims[1] - 1), float(dims[2] - 1)},
+            {dims[0] - 2, dims[1] - 2, dims[2] - 2},
+            int32_t(dims[0]),
+            int32_t(dims[0]) * int32_t(dims[1]),
+            {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z}};
+}
+
+template <class T, class Ops>
+class ShadedStream {
+public:
+    ShadedStream(const Context& c, const T* data, const simd::ShadeGrid& sg,
+                 const kernel::IndexRay& r, Vec3f view, float t_base, kernel::Accum& acc)
+        : m_c(c),
+          m_data(data),
+          m_sg(sg),
+          m_sr{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}, t_base, c.dt},
+          m_view(view),
+          m_acc(acc) {
+        // Head and directional lights: l, li and the half vector are those of every sample.
+        const Light& L = c.f->light;
+        m_fixed_light = L.kind != LightKind::Spot;
+        if (m_fixed_light) {
+            m_l = L.kind == LightKind::Head ? view : c.light_dir;
+            m_li = L.intensity;
+            m_h_ok = shading::half_vector(m_l, view, m_h);
+        }
+    }
+
+    // Queues the samples [kb, ke); false once the ray is opaque.
+    bool add(int kb, int ke) {
+        while (kb < ke) {
+            const int take = std::min(ke - kb, kShadeBatch - m_m);
+            for (int l = 0; l < take; ++l) m_k[m_m + l] = kb + l;
+            m_m += take;
+            kb += take;
+            if (m_m == kShadeBatch && !flush()) return false;
+        }
+        return !m_done;
+    }
+    void finish() {
+        if (m_m > 0 && !m_done) flush();
+        m_m = 0;
+    }
+    uint32_t samples() const { return m_n; }
+
+private:
+    bool flush() {
+        const Context& c = m_c;
+        const FeatureOptions& f = *c.f;
+        const int m = m_m;
+        m_m = 0;
+        // 1. Positions (composite_ray's step 1) and values; the batch is padded with its last
+        // sample.
+        for (int l = m; l < kShadeBatch; ++l) m_k[l] = m_k[m - 1];
+        alignas(32) float x[kShadeBatch], y[kShadeBatch], z[kShadeBatch], v[kShadeBatch];
+        Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, m);
+        // 2. Clip test, side, TF entry; which slots are visible.
+        enum : uint8_t { kClipped, kClear, kVisible };
+        uint8_t kind[kShadeBatch];
+        int side[kShadeBatch], entry[kShadeBatch];
+        unsigned visible = 0;
+        for (int l = 0; l < m; ++l) {
+            if (!c.kept(x[l], y[l], z[l])) {
+                kind[l] = kClipped;
+                continue;
+            }
+            side[l] = c.side(x[l], y[l], z[l]);
+            entry[l] = c.map(v[l]);
+            if (!(c.raw[side[l]][entry[l]].a > 0.f)) {
+                kind[l] = kClear;
+                continue;
+            }
+            kind[l] = kVisible;
+            visible |= 1u << l;
+        }
+        // 3. Gradients at the batch's positions (used for the visible slots only).
+        alignas(32) float gx[kShadeBatch], gy[kShadeBatch], gz[kShadeBatch];
+        if (visible && c.need_gradient) {
+            if (c.grad[0])
+                Ops::volume_gradients(m_sg, c.grad, x, y, z, gx, gy, gz, visible);
+            else
+                Ops::gradients(m_sg, m_data, x, y, z, gx, gy, gz, visible);
+        }
+        // 4. In k order: count, shade and composite (composite_ray's steps 2-4).
+        kernel::Accum acc = m_acc;
+        for (int l = 0; l < m; ++l) {
+            if (kind[l] == kClipped) continue;
+            ++m_n;
+            if (kind[l] == kClear) continue;
+            const int j = l;
+            const Rgba& raw = c.raw[side[l]][entry[l]];
+            float a = c.corr[side[l]][entry[l]].a;
+            Vec3f rgb{raw.r, raw.g, raw.b};
+            if (c.need_gradient) {
+                const Vec3f grad{gx[j], gy[j], gz[j]};
+                if (f.gradient_opacity.enabled) {
+                    const float am = std::min(raw.a, 1.f) *
+                                     shading::gradient_opacity(f.gradient_opacity, length(grad));
+                    if (!(am > 0.f)) continue;
+                    a = 1.f - std::pow(1.f - am, c.step);
+                }
+                Vec3f nrm;
+                if (f.shading != ShadingModel::None &&
+                    shading::normal_from_gradient(grad, m_view, nrm)) {
+                    if (m_fixed_light) {
+                        rgb = f.shading == ShadingModel::Phong
+                                  ? shading::phong_h(f.phong, rgb, nrm, m_l, m_h, m_h_ok, m_li)
+                                  : shading::pbr_h(f.pbr, rgb, nrm, m_l, m_view,
+                                                   m_h_ok ? m_h : nrm, m_li);
+                    } else {
+                        const Vec3f pw = Vec3f{x[l], y[l], z[l]} * c.sp;
+                        Vec3f lt;
+                        float li, dist;
+                        light_at(c, pw, m_view, lt, li, dist);
+                        rgb = f.shading == ShadingModel::Phong
+                                  ? shading::phong(f.phong, rgb, nrm, lt, m_view, li)
+                                  : shading::pbr(f.pbr, rgb, nrm, lt, m_view, li);
+                    }
+                }
+            }
+            const float w = 1.f - acc.a;
+            acc.r += w * rgb.x * a;
+            acc.g += w * rgb.y * a;
+            acc.b += w * rgb.z * a;
+            acc.a += w * a;
+            if (acc.a >= c.ert) {
+                m_done = true;
+                break;
+            }
+        }
+        m_acc = acc;
+        return !m_done;
+    }
+
+    const Context& m_c;
+    const T* m_data;
+    const simd::ShadeGrid& m_sg;
+    simd::ShadeRay m_sr;
+    Vec3f m_view;
+    kernel::Accum& m_acc;
+    bool m_fixed_light = false, m_h_ok = false, m_done = false;
+    Vec3f m_l{0, 0, 1}, m_h{0, 0, 1};
+    float m_li = 0.f;
+    alignas(32) int32_t m_k[kShadeBatch];
+    int m_m = 0;
+    uint32_t m_n = 0;
+};
+
 // MIP / MinIP: track the extreme LUT entry (src/accel/entry_window.h); `lo`/`hi` is the window
 // of entries that can still change it, read by an EntryWindowView cursor.
 template <class T, class Index, class Cursor>
@@ -342,10 +557,13 @@ inline uint32_t average_ray(const Context& c, const kernel::Grid<T, Index>& g, C
 
 // One tile of the feature path: per pixel, the ray, its (jittered) lattice, the cursor of the
 // blend mode, and the pixel.
-template <class T, class Index, class S>
+//
+// Ops: ShadeOps<W> of the active SIMD path, run for composite rays without shadows through
+// ShadedStream (`sg` is then the grid's int32 geometry); void: composite_ray, the reference.
+template <class Ops, class T, class Index, class S>
 void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>& g,
-                 const Camera& cam, const RenderOptions& opt, int x0, int y0, int x1, int y1,
-                 RenderResult& out, Counts& counts) {
+                 const simd::ShadeGrid& sg, const Camera& cam, const RenderOptions& opt, int x0,
+                 int y0, int x1, int y1, RenderResult& out, Counts& counts) {
     const FeatureOptions& f = *c.f;
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     const float chunk = kCursorChunk * c.dt;
@@ -383,10 +601,17 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                 } else {
                     typename S::Cursor cursor(accel, cr, t_near, t_far, c.dt,
                                               f.blend == BlendMode::Composite && c.ert < 1.f ? chunk : 0.f);
-                    if (f.blend == BlendMode::Average)
+                    if (f.blend == BlendMode::Average) {
                         n = average_ray(c, g, cursor, r, t_base, k_end, acc);
-                    else
+                    } else if constexpr (!std::is_void_v<Ops>) {
+                        ShadedStream<T, Ops> stream(c, g.data, sg, r, view, t_base, acc);
+                        for_each_lattice_run(cursor, t_base, c.dt, k_end,
+                                             [&](int kb, int ke) { return stream.add(kb, ke); });
+                        stream.finish();
+                        n = stream.samples();
+                    } else {
                         n = composite_ray(c, g, accel, cursor, r, view, t_base, k_end, acc, counts.shadow);
+                    }
                 }
             }
             counts.samples += n;

@@ -206,15 +206,34 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
                 c.inv_stride = 1.f / float(stride);
                 out.stats.light_volume_bytes = m_cache->light.size() * sizeof(float);
             }
-            // 5. The frame.
-            parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
-                               [&](int x0, int y0, int x1, int y1) {
-                                   feature::Counts n;
-                                   feature::render_tile(c, acc, g, cam, opt, x0, y0, x1, y1, out, n);
-                                   samples += n.samples;
-                                   rays += n.rays;
-                                   shadow += n.shadow;
-                               });
+            // 5. The frame: composite rays without shadows on the batched SIMD path of the
+            // active ISA (int32 offsets: grids under 2^31 voxels), the rest one sample at a
+            // time (feature::composite_ray, the reference; also the scalar ISA path).
+            const int dims[3] = {d.x, d.y, d.z};
+            const simd::ShadeGrid sg = feature::shade_grid(c, dims);
+            const bool batched = composite && !f.shadows.enabled &&
+                                 m_volume.voxel_count() < (size_t(1) << 31);
+            auto frame = [&](auto ops) {
+                using Ops = typename decltype(ops)::type;
+                parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                                   [&](int x0, int y0, int x1, int y1) {
+                                       feature::Counts n;
+                                       feature::render_tile<Ops>(c, acc, g, sg, cam, opt, x0, y0,
+                                                                 x1, y1, out, n);
+                                       samples += n.samples;
+                                       rays += n.rays;
+                                       shadow += n.shadow;
+                                   });
+            };
+            const simd::Isa isa = batched ? simd::active_isa() : simd::Isa::Scalar;
+#if LACUNA_SIMD_X86
+            if (isa == simd::Isa::Avx2 || isa == simd::Isa::Avx512)
+                return frame(std::type_identity<feature::ShadeOps<8>>{});
+#if defined(__SSE4_1__)
+            if (isa == simd::Isa::Sse41) return frame(std::type_identity<feature::ShadeOps<4>>{});
+#endif
+#endif
+            frame(std::type_identity<void>{});
         });
     });
     out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

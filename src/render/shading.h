@@ -28,16 +28,32 @@ inline bool normal_from_gradient(Vec3f g, Vec3f view, Vec3f& n) {
 }
 
 // Blinn-Phong: rgb*(ambient + diffuse*Li*max(N.L,0)) + specular*Li*max(N.H,0)^power.
-// `li` is the light's intensity at the sample (spot falloff and shadowing applied).
-inline Vec3f phong(const PhongParams& p, Vec3f rgb, Vec3f n, Vec3f l, Vec3f v, float li) {
+// `li` is the light's intensity at the sample (spot falloff and shadowing applied). `hn` is the
+// unit half vector (l + v)/|l + v|, used only when `h_ok` (|l + v| > 0): phong() computes it per
+// sample; the feature kernel's batched path once per ray when l and v are fixed (same bits).
+inline Vec3f phong_h(const PhongParams& p, Vec3f rgb, Vec3f n, Vec3f l, Vec3f hn, bool h_ok,
+                     float li) {
     const float ndl = std::max(dot(n, l), 0.f);
-    Vec3f h = l + v;
-    const float hl = length(h);
     float spec = 0.f;
-    if (ndl > 0.f && hl > 0.f) spec = std::pow(std::max(dot(n, h / hl), 0.f), p.power);
+    if (ndl > 0.f && h_ok) spec = std::pow(std::max(dot(n, hn), 0.f), p.power);
     const float k = p.ambient + p.diffuse * li * ndl;
     const float s = p.specular * li * spec;
     return {rgb.x * k + s, rgb.y * k + s, rgb.z * k + s};
+}
+
+// The half vector of phong() and pbr(): (l + v)/|l + v|, and whether |l + v| > 0.
+inline bool half_vector(Vec3f l, Vec3f v, Vec3f& hn) {
+    const Vec3f h = l + v;
+    const float hl = length(h);
+    if (!(hl > 0.f)) return false;
+    hn = h / hl;
+    return true;
+}
+
+inline Vec3f phong(const PhongParams& p, Vec3f rgb, Vec3f n, Vec3f l, Vec3f v, float li) {
+    Vec3f hn{0, 0, 0};
+    const bool h_ok = half_vector(l, v, hn);
+    return phong_h(p, rgb, n, l, hn, h_ok, li);
 }
 
 // Disney diffuse (Burley 2012), without the 1/pi (Unity's convention: the light's intensity is
@@ -73,14 +89,13 @@ inline float schlick(float f0, float ldh) {
 
 // The physically based model: albedo*(1-metallic) * (ambient + Li * Disney * N.L)
 //   + Li * pi * D * V * F * N.L,  F0 = lerp(0.04, albedo, metallic).
-inline Vec3f pbr(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, float li) {
+// `h` is the unit half vector (n where l + v = 0): pbr() computes it per sample, the batched
+// path once per ray when l and v are fixed (same bits).
+inline Vec3f pbr_h(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, Vec3f h, float li) {
     const float rough = std::clamp(p.roughness, 0.02f, 1.f);
     const float alpha = rough * rough;
     const float ndl = std::max(dot(n, l), 0.f);
     const float ndv = std::max(dot(n, v), 1e-4f);
-    Vec3f h = l + v;
-    const float hl = length(h);
-    h = hl > 0.f ? h / hl : n;
     const float ndh = std::max(dot(n, h), 0.f), ldh = std::max(dot(l, h), 0.f);
     const float diffuse = li * disney_diffuse(ndv, ndl, ldh, rough) * ndl;
     const float spec_common = li * kPi * ggx_d(ndh, alpha) * smith_joint_ggx_v(ndl, ndv, alpha) * ndl;
@@ -93,6 +108,12 @@ inline Vec3f pbr(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, fl
         out[i] = kd * (p.ambient + diffuse) + spec_common * schlick(f0, ldh);
     }
     return {out[0], out[1], out[2]};
+}
+
+inline Vec3f pbr(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, float li) {
+    Vec3f h = n;
+    half_vector(l, v, h);
+    return pbr_h(p, albedo, n, l, v, h, li);
 }
 
 // Spot falloff: 1 inside 0.8*cone, 0 outside the cone, smoothstep between.

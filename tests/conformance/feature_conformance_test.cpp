@@ -9,6 +9,7 @@
 #include <functional>
 
 #include "conformance/conformance_util.h"
+#include "core/simd_lanes.h"
 #include "lacuna/accel.h"
 #include "lacuna/renderer.h"
 
@@ -53,6 +54,19 @@ std::vector<FeatureCase> feature_cases() {
          [](FeatureOptions& f, const Volume&, Rng&) {
              f.shading = ShadingModel::Phong;
              f.gradient = GradientSource::Precomputed;
+         }},
+        {"pbr head", [](FeatureOptions& f, const Volume&, Rng&) { f.shading = ShadingModel::Pbr; }},
+        {"phong spot + clip",
+         [](FeatureOptions& f, const Volume& v, Rng& r) {
+             f.shading = ShadingModel::Phong;
+             f.light = random_light(v, r, LightKind::Spot);
+             f.clip_planes.push_back(random_plane(v, r));
+         }},
+        {"pbr gradient volume directional",
+         [](FeatureOptions& f, const Volume& v, Rng& r) {
+             f.shading = ShadingModel::Pbr;
+             f.gradient = GradientSource::Precomputed;
+             f.light = random_light(v, r, LightKind::Directional);
          }},
         {"pbr directional",
          [](FeatureOptions& f, const Volume& v, Rng& r) {
@@ -199,6 +213,76 @@ TEST(FeatureConformance, EveryOptionIsExactForEveryStructure) {
                          fc.two_tfs ? &back_lut : nullptr, cam, ro, ao);
         }
     }
+}
+
+// Every kernel path this CPU runs (core/simd_lanes.h: the scalar path is feature::composite_ray,
+// one sample at a time; SSE4.1, AVX2 and AVX-512 run the batched ShadedStream with the lanes of
+// core/simd_shading.h) gives the bytes, float accumulations and per-pixel sample counts of the
+// scalar --accel none render, for every feature option and structure, with and without early
+// termination. Half the trials use a dense LUT (every entry different, so a value one ulp off
+// lands in another entry and shows).
+TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
+    struct Restore {
+        simd::Isa isa = simd::active_isa();
+        ~Restore() { simd::set_isa(isa); }
+    } restore;
+    std::vector<simd::Isa> paths;
+    for (simd::Isa i : {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
+        if (simd::isa_supported(i)) paths.push_back(i);
+    ASSERT_GE(paths.size(), 2u) << "at least the scalar path and one SIMD path";
+    Rng rng{2031};
+    int compared = 0;
+    for (const FeatureCase& fc : feature_cases()) {
+        for (int trial = 0; trial < 3; ++trial) {
+            const Volume v = test::random_volume(rng, 26);
+            TransferLut front = test::random_lut(v.vis_range(), rng);
+            if (trial == 1) {
+                front.entries.resize(size_t(1) << 16);
+                for (Rgba& e : front.entries)
+                    e = {rng.uniform(), rng.uniform(), rng.uniform(), rng.coin(3) ? 0.f : rng.uniform()};
+            }
+            const TransferLut back_lut = test::random_lut(v.vis_range(), rng);
+            const TransferLut* back = fc.two_tfs && trial != 1 ? &back_lut : nullptr;
+            RenderOptions o;
+            o.keep_float = true;
+            o.count_samples = true;
+            o.step = 0.2f + 1.2f * rng.uniform();
+            o.ert = trial == 2 ? 2.f : 0.8f + 0.19f * rng.uniform();
+            o.tile = rng.range(3, 17);
+            fc.set(o.features, v, rng);
+            if (fc.two_tfs && !back) o.features.clip_planes.push_back(random_plane(v, rng));
+            const Camera cam = test::random_camera(v, rng, 21);
+            RayMarcher m(v);
+            m.set_transfer_function(front);
+            if (back) m.set_back_transfer_function(*back);
+            simd::set_isa(simd::Isa::Scalar);
+            const RenderResult ref = m.render(cam, o);
+            const TransferLut skip_lut = back ? union_lut(front, *back) : front;
+            for (AccelKind k : all_accel_kinds()) {
+                auto accel = make_accel(k, v);
+                accel->set_transfer_function(skip_lut);
+                RayMarcher ma(v);
+                ma.set_transfer_function(front);
+                if (back) ma.set_back_transfer_function(*back);
+                ma.set_accel(accel.get());
+                for (simd::Isa isa : paths) {
+                    simd::set_isa(isa);
+                    const RenderResult r = ma.render(cam, o);
+                    const std::string what = std::string(fc.name) + " trial " + std::to_string(trial) +
+                                             " " + to_string(v.type()) + " accel " + to_string(k) +
+                                             " path " + simd::to_string(isa);
+                    ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
+                    ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
+                                             ref.rgba_float.size() * sizeof(float)))
+                        << what << ": float accumulations differ";
+                    if (k == AccelKind::None) ASSERT_EQ(r.sample_counts, ref.sample_counts) << what;
+                    ASSERT_LE(r.stats.samples, ref.stats.samples) << what;
+                    ++compared;
+                }
+            }
+        }
+    }
+    EXPECT_GT(compared, 500);
 }
 
 TEST(FeatureConformance, AcceleratedShadowRaysEqualUnacceleratedOnes) {

@@ -1,0 +1,259 @@
+// SIMD helpers of the shaded ray path (src/render/feature_kernel.h, docs/shading.md "Batched
+// shading"): trilinear values and on-the-fly central-difference gradients of a batch of sample
+// positions, one sample per lane. SSE4.1 (4 lanes, the baseline) and AVX2 (8 lanes, through
+// __attribute__((target)) like core/simd_lanes.h; run only after simd::isa_supported).
+//
+// Bit-exactness with kernel::trilinear() and feature::gradient(): each lane performs the scalar
+// operations of its own sample in the same order. Clamps: std::clamp(x, 0, hi) is
+// x < 0 ? 0 : (hi < x ? hi : x) == max_ps(0, min_ps(hi, x)) (min/max return their second operand
+// on ties, so -0 and NaN come out alike); int() truncates like cvttps; corners convert exactly
+// (integers below 2^24, or floats as they are); lerps are a + w * (b - a) with mul and add kept
+// apart (-ffp-contract=off, no fma intrinsics). The gradient's neighbour positions are x + 1.f and
+// x - 1.f in single precision, as the scalar code computes them, never a shifted cell.
+//
+// Offsets are int32: callers use these only for grids under 2^31 voxels.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "core/simd_lanes.h"
+
+namespace lacuna::simd {
+
+// The sampled grid, as kernel::Grid holds it.
+struct ShadeGrid {
+    float hi[3];       // dims - 1
+    int32_t cell[3];   // dims - 2
+    int32_t sy, sz;    // strides of j and k
+    float inv_sp[3];   // 1 / spacing: index-space differences -> values per mm
+};
+
+// One ray's sample lattice in index space: sample k at o + t*d, t = t_base + (k + 0.5)*dt
+// (composite_ray's positions, operation for operation).
+struct ShadeRay {
+    float o[3], d[3];
+    float t_base, dt;
+};
+
+#if LACUNA_SIMD_X86 && defined(__SSE4_1__)
+
+// ---- SSE4.1: four lanes ------------------------------------------------------------------
+template <class T>
+inline __m128 trilinear4(const ShadeGrid& g, const T* data, __m128 x, __m128 y, __m128 z) {
+    const __m128 zero = _mm_setzero_ps();
+    __m128 p[3] = {x, y, z}, f[3];
+    __m128i c[3];
+    for (int a = 0; a < 3; ++a) {
+        const __m128 q = _mm_max_ps(zero, _mm_min_ps(_mm_set1_ps(g.hi[a]), p[a]));
+        c[a] = _mm_min_epi32(_mm_cvttps_epi32(q), _mm_set1_epi32(g.cell[a]));
+        f[a] = _mm_sub_ps(q, _mm_cvtepi32_ps(c[a]));
+    }
+    const __m128i off = _mm_add_epi32(_mm_add_epi32(_mm_mullo_epi32(c[2], _mm_set1_epi32(g.sz)),
+                                                    _mm_mullo_epi32(c[1], _mm_set1_epi32(g.sy))),
+                                      c[0]);
+    alignas(16) int32_t o[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(o), off);
+    const ptrdiff_t sy = g.sy, sz = g.sz, syz = sy + sz;
+    const T* p0 = data + o[0];
+    const T* p1 = data + o[1];
+    const T* p2 = data + o[2];
+    const T* p3 = data + o[3];
+    auto corner = [&](ptrdiff_t d) {
+        return _mm_setr_ps(float(p0[d]), float(p1[d]), float(p2[d]), float(p3[d]));
+    };
+    auto lerp = [](__m128 a, __m128 b, __m128 w) {
+        return _mm_add_ps(a, _mm_mul_ps(w, _mm_sub_ps(b, a)));
+    };
+    const __m128 c00 = lerp(corner(0), corner(1), f[0]);
+    const __m128 c10 = lerp(corner(sy), corner(sy + 1), f[0]);
+    const __m128 c01 = lerp(corner(sz), corner(sz + 1), f[0]);
+    const __m128 c11 = lerp(corner(syz), corner(syz + 1), f[0]);
+    const __m128 c0 = lerp(c00, c10, f[1]), c1 = lerp(c01, c11, f[1]);
+    return lerp(c0, c1, f[2]);
+}
+
+// The positions of lattice samples k[0..3] into x, y, z, and their trilinear values into v.
+template <class T>
+inline void samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
+                     float* x, float* y, float* z, float* v) {
+    const __m128 t = _mm_add_ps(
+        _mm_set1_ps(r.t_base),
+        _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k))),
+                              _mm_set1_ps(0.5f)),
+                   _mm_set1_ps(r.dt)));
+    const __m128 px = _mm_add_ps(_mm_set1_ps(r.o[0]), _mm_mul_ps(t, _mm_set1_ps(r.d[0])));
+    const __m128 py = _mm_add_ps(_mm_set1_ps(r.o[1]), _mm_mul_ps(t, _mm_set1_ps(r.d[1])));
+    const __m128 pz = _mm_add_ps(_mm_set1_ps(r.o[2]), _mm_mul_ps(t, _mm_set1_ps(r.d[2])));
+    _mm_storeu_ps(x, px), _mm_storeu_ps(y, py), _mm_storeu_ps(z, pz);
+    _mm_storeu_ps(v, trilinear4(g, data, px, py, pz));
+}
+
+// Central differences of trilinear samples one voxel to either side, in values per mm
+// (feature::gradient's on-the-fly branch), for 4 positions.
+template <class T>
+inline void gradients4(const ShadeGrid& g, const T* data, const float* px, const float* py,
+                       const float* pz, float* gx, float* gy, float* gz) {
+    const __m128 one = _mm_set1_ps(1.f), half = _mm_set1_ps(0.5f);
+    const __m128 x = _mm_loadu_ps(px), y = _mm_loadu_ps(py), z = _mm_loadu_ps(pz);
+    const __m128 dx = _mm_sub_ps(trilinear4(g, data, _mm_add_ps(x, one), y, z),
+                                 trilinear4(g, data, _mm_sub_ps(x, one), y, z));
+    const __m128 dy = _mm_sub_ps(trilinear4(g, data, x, _mm_add_ps(y, one), z),
+                                 trilinear4(g, data, x, _mm_sub_ps(y, one), z));
+    const __m128 dz = _mm_sub_ps(trilinear4(g, data, x, y, _mm_add_ps(z, one)),
+                                 trilinear4(g, data, x, y, _mm_sub_ps(z, one)));
+    _mm_storeu_ps(gx, _mm_mul_ps(_mm_mul_ps(dx, half), _mm_set1_ps(g.inv_sp[0])));
+    _mm_storeu_ps(gy, _mm_mul_ps(_mm_mul_ps(dy, half), _mm_set1_ps(g.inv_sp[1])));
+    _mm_storeu_ps(gz, _mm_mul_ps(_mm_mul_ps(dz, half), _mm_set1_ps(g.inv_sp[2])));
+}
+
+// The precomputed gradient volume's three trilinear lookups (feature::gradient's first branch),
+// 4 positions: float grids with the sampled grid's geometry.
+inline void volume_gradients4(const ShadeGrid& g, const float* const grad[3], const float* px,
+                              const float* py, const float* pz, float* gx, float* gy, float* gz) {
+    const __m128 x = _mm_loadu_ps(px), y = _mm_loadu_ps(py), z = _mm_loadu_ps(pz);
+    _mm_storeu_ps(gx, trilinear4(g, grad[0], x, y, z));
+    _mm_storeu_ps(gy, trilinear4(g, grad[1], x, y, z));
+    _mm_storeu_ps(gz, trilinear4(g, grad[2], x, y, z));
+}
+
+#endif  // SSE4.1
+
+#if LACUNA_SIMD_X86
+
+// ---- AVX2: eight lanes -------------------------------------------------------------------
+// Corners by gathers, as march_lanes8 reads them: for uint8 a 32-bit gather per corner pair,
+// the pairs past the first read from 2 bytes before them so no read passes the last voxel.
+template <class T>
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const ShadeGrid& g,
+                                                                    const T* data, __m256 x,
+                                                                    __m256 y, __m256 z) {
+    const __m256 zero = _mm256_setzero_ps();
+    x = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), x));
+    y = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), y));
+    z = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), z));
+    const __m256i ci = _mm256_min_epi32(_mm256_cvttps_epi32(x), _mm256_set1_epi32(g.cell[0]));
+    const __m256i cj = _mm256_min_epi32(_mm256_cvttps_epi32(y), _mm256_set1_epi32(g.cell[1]));
+    const __m256i ck = _mm256_min_epi32(_mm256_cvttps_epi32(z), _mm256_set1_epi32(g.cell[2]));
+    const __m256 fx = _mm256_sub_ps(x, _mm256_cvtepi32_ps(ci));
+    const __m256 fy = _mm256_sub_ps(y, _mm256_cvtepi32_ps(cj));
+    const __m256 fz = _mm256_sub_ps(z, _mm256_cvtepi32_ps(ck));
+    const __m256i off = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                         _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+        ci);
+    constexpr bool kByte = sizeof(T) == 1;
+    const __m256i o1 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy - 2 : g.sy));
+    const __m256i o2 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sz - 2 : g.sz));
+    const __m256i o3 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz));
+    __m256 c000, c100, c010, c110, c001, c101, c011, c111;
+    if constexpr (kByte) {
+        const int* base = reinterpret_cast<const int*>(data);
+        const __m256i w0 = _mm256_i32gather_epi32(base, off, 1);
+        const __m256i w1 = _mm256_i32gather_epi32(base, o1, 1);
+        const __m256i w2 = _mm256_i32gather_epi32(base, o2, 1);
+        const __m256i w3 = _mm256_i32gather_epi32(base, o3, 1);
+        const __m256i m = _mm256_set1_epi32(0xff);
+        c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
+        c100 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w0, 8), m));
+        c010 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w1, 16), m));
+        c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 24));
+        c001 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w2, 16), m));
+        c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 24));
+        c011 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w3, 16), m));
+        c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 24));
+    } else if constexpr (sizeof(T) == 2) {
+        const int* base = reinterpret_cast<const int*>(data);
+        const __m256i w0 = _mm256_i32gather_epi32(base, off, 2);
+        const __m256i w1 = _mm256_i32gather_epi32(base, o1, 2);
+        const __m256i w2 = _mm256_i32gather_epi32(base, o2, 2);
+        const __m256i w3 = _mm256_i32gather_epi32(base, o3, 2);
+        if constexpr (std::is_signed_v<T>) {
+            c000 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w0, 16), 16));
+            c010 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w1, 16), 16));
+            c001 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w2, 16), 16));
+            c011 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w3, 16), 16));
+            c100 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w0, 16));
+            c110 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w1, 16));
+            c101 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w2, 16));
+            c111 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w3, 16));
+        } else {
+            const __m256i m = _mm256_set1_epi32(0xffff);
+            c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
+            c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
+            c001 = _mm256_cvtepi32_ps(_mm256_and_si256(w2, m));
+            c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
+            c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 16));
+            c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 16));
+            c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 16));
+            c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 16));
+        }
+    } else {
+        static_assert(std::is_same_v<T, float>, "voxel types: uint8, int16, uint16, float");
+        const float* base = data;
+        c000 = _mm256_i32gather_ps(base, off, 4);
+        c100 = _mm256_i32gather_ps(base + 1, off, 4);
+        c010 = _mm256_i32gather_ps(base, o1, 4);
+        c110 = _mm256_i32gather_ps(base + 1, o1, 4);
+        c001 = _mm256_i32gather_ps(base, o2, 4);
+        c101 = _mm256_i32gather_ps(base + 1, o2, 4);
+        c011 = _mm256_i32gather_ps(base, o3, 4);
+        c111 = _mm256_i32gather_ps(base + 1, o3, 4);
+    }
+    const __m256 c00 = _mm256_add_ps(c000, _mm256_mul_ps(fx, _mm256_sub_ps(c100, c000)));
+    const __m256 c10 = _mm256_add_ps(c010, _mm256_mul_ps(fx, _mm256_sub_ps(c110, c010)));
+    const __m256 c01 = _mm256_add_ps(c001, _mm256_mul_ps(fx, _mm256_sub_ps(c101, c001)));
+    const __m256 c11 = _mm256_add_ps(c011, _mm256_mul_ps(fx, _mm256_sub_ps(c111, c011)));
+    const __m256 c0 = _mm256_add_ps(c00, _mm256_mul_ps(fy, _mm256_sub_ps(c10, c00)));
+    const __m256 c1 = _mm256_add_ps(c01, _mm256_mul_ps(fy, _mm256_sub_ps(c11, c01)));
+    return _mm256_add_ps(c0, _mm256_mul_ps(fz, _mm256_sub_ps(c1, c0)));
+}
+
+// samples4's eight-lane twin.
+template <class T>
+LACUNA_AVX2 void samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
+                          float* x, float* y, float* z, float* v) {
+    const __m256 t = _mm256_add_ps(
+        _mm256_set1_ps(r.t_base),
+        _mm256_mul_ps(
+            _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k))),
+                          _mm256_set1_ps(0.5f)),
+            _mm256_set1_ps(r.dt)));
+    const __m256 px = _mm256_add_ps(_mm256_set1_ps(r.o[0]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[0])));
+    const __m256 py = _mm256_add_ps(_mm256_set1_ps(r.o[1]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[1])));
+    const __m256 pz = _mm256_add_ps(_mm256_set1_ps(r.o[2]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[2])));
+    _mm256_storeu_ps(x, px), _mm256_storeu_ps(y, py), _mm256_storeu_ps(z, pz);
+    _mm256_storeu_ps(v, trilinear8(g, data, px, py, pz));
+}
+
+// gradients4's eight-lane twin.
+template <class T>
+LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, const float* py,
+                            const float* pz, float* gx, float* gy, float* gz) {
+    const __m256 one = _mm256_set1_ps(1.f), half = _mm256_set1_ps(0.5f);
+    const __m256 x = _mm256_loadu_ps(px), y = _mm256_loadu_ps(py), z = _mm256_loadu_ps(pz);
+    const __m256 dx = _mm256_sub_ps(trilinear8(g, data, _mm256_add_ps(x, one), y, z),
+                                    trilinear8(g, data, _mm256_sub_ps(x, one), y, z));
+    const __m256 dy = _mm256_sub_ps(trilinear8(g, data, x, _mm256_add_ps(y, one), z),
+                                    trilinear8(g, data, x, _mm256_sub_ps(y, one), z));
+    const __m256 dz = _mm256_sub_ps(trilinear8(g, data, x, y, _mm256_add_ps(z, one)),
+                                    trilinear8(g, data, x, y, _mm256_sub_ps(z, one)));
+    _mm256_storeu_ps(gx, _mm256_mul_ps(_mm256_mul_ps(dx, half), _mm256_set1_ps(g.inv_sp[0])));
+    _mm256_storeu_ps(gy, _mm256_mul_ps(_mm256_mul_ps(dy, half), _mm256_set1_ps(g.inv_sp[1])));
+    _mm256_storeu_ps(gz, _mm256_mul_ps(_mm256_mul_ps(dz, half), _mm256_set1_ps(g.inv_sp[2])));
+}
+
+// The precomputed gradient volume's three trilinear lookups (feature::gradient's first branch),
+// 8 positions: float grids with the sampled grid's geometry.
+LACUNA_AVX2 inline void volume_gradients8(const ShadeGrid& g, const float* const grad[3],
+                                          const float* px, const float* py, const float* pz,
+                                          float* gx, float* gy, float* gz) {
+    const __m256 x = _mm256_loadu_ps(px), y = _mm256_loadu_ps(py), z = _mm256_loadu_ps(pz);
+    _mm256_storeu_ps(gx, trilinear8(g, grad[0], x, y, z));
+    _mm256_storeu_ps(gy, trilinear8(g, grad[1], x, y, z));
+    _mm256_storeu_ps(gz, trilinear8(g, grad[2], x, y, z));
+}
+
+#endif  // LACUNA_SIMD_X86
+
+}  // namespace lacuna::simd
