@@ -126,6 +126,13 @@ public:
             m_b[a] = std::min(int(p) >> L, m_nbm1[a]);
         }
         for (int a = 0; a < 3; ++a) m_next[a] = crossing(a, m_b[a], L);
+        const int64_t stride[3] = {1, g.m_nw[0], int64_t(g.m_nw[0]) * g.m_nw[1]};
+        for (int a = 0; a < 3; ++a) {
+            m_blk_delta[a] = m_step[a] * stride[a];
+            m_bit_delta[a] = m_step[a] << (2 * a);
+            m_bit_wrap[a] = m_step[a] > 0 ? -(3 << (2 * a)) : (3 << (2 * a));
+        }
+        locate();
     }
 
     // One step of the walk: the stretch [t0, t1] of the ray in the bricks lo..hi (inclusive):
@@ -136,10 +143,12 @@ public:
         int lo[3], hi[3];
         bool occupied, coarse;
     };
+    // kBox: also report the step's brick box (tests); the renderer's walk skips that work.
+    template <bool kBox = true>
     bool step(Step& s) {
         if (!(m_t < m_far)) return false;
         const int L = m_g.m_log2;
-        const size_t blk = m_g.block_index(m_b[0], m_b[1], m_b[2]);
+        const size_t blk = size_t(m_blk);
         const uint64_t w = m_g.m_words[blk];
         int a;
         float t_exit;
@@ -169,19 +178,28 @@ public:
         }
         a = argmin(m_next);
         t_exit = m_next[a];
-        s.occupied = (w >> bit(m_b[0], m_b[1], m_b[2])) & 1u;
+        s.occupied = (w >> m_bit) & 1u;
         s.t0 = m_t;
         s.t1 = std::max(std::min(t_exit, m_far), m_t);
-        for (int c = 0; c < 3; ++c) s.lo[c] = s.hi[c] = m_b[c];
+        if constexpr (kBox)
+            for (int c = 0; c < 3; ++c) s.lo[c] = s.hi[c] = m_b[c];
         m_t = s.t1;
-        m_b[a] += m_step[a];
-        m_next[a] = crossing(a, m_b[a], L);
+        // The next brick on axis a; its block and bit follow incrementally.
+        const int nb = m_b[a] + m_step[a];
+        if ((nb >> 2) != (m_b[a] >> 2)) {
+            m_blk += m_blk_delta[a];
+            m_bit += m_bit_wrap[a];
+        } else {
+            m_bit += m_bit_delta[a];
+        }
+        m_b[a] = nb;
+        m_next[a] = crossing(a, nb, L);
         return true;
     }
 
     bool next(Segment& out) {
         Step s;
-        while (step(s)) {
+        while (step<false>(s)) {
             if (s.occupied) {
                 bool emit = false;
                 if (!m_open) {
@@ -246,6 +264,13 @@ private:
         }
         m_b[a] = m_d[a] > 0.f ? hi[a] + 1 : lo[a] - 1;
         for (int c = 0; c < 3; ++c) m_next[c] = crossing(c, m_b[c], L);
+        locate();
+    }
+    // Block index and bit of the current brick (on a brick past the grid after the last leap,
+    // the walk is over and they are never read).
+    void locate() {
+        m_blk = int64_t(m_g.block_index(m_b[0], m_b[1], m_b[2]));
+        m_bit = bit(m_b[0], m_b[1], m_b[2]);
     }
 
     const BrickGrid& m_g;
@@ -253,6 +278,8 @@ private:
     int m_cells[3], m_nbm1[3];
     int m_up[3], m_step[3], m_lo_lim[3], m_hi_lim[3];
     int m_b[3];
+    int64_t m_blk = 0, m_blk_delta[3];
+    int m_bit = 0, m_bit_delta[3], m_bit_wrap[3];
     float m_next[3];
     float m_t, m_far, m_min_skip, m_chunk;
     float m_start = 0.f, m_gap_start = 0.f;
