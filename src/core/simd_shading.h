@@ -13,6 +13,8 @@
 //
 // Offsets are int32: callers use these only for grids under 2^31 voxels.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -252,6 +254,134 @@ LACUNA_AVX2 inline void volume_gradients8(const ShadeGrid& g, const float* const
     _mm256_storeu_ps(gx, trilinear8(g, grad[0], x, y, z));
     _mm256_storeu_ps(gy, trilinear8(g, grad[1], x, y, z));
     _mm256_storeu_ps(gz, trilinear8(g, grad[2], x, y, z));
+}
+
+// ---- Shading of eight samples (AVX2) -----------------------------------------------------
+// shading::normal_from_gradient, then shading::phong_h or shading::pbr_h, for a light whose
+// direction l, intensity li and half vector h are the same for all lanes (head and directional
+// lights, once per ray), with the view direction v. Lane by lane the operations of the scalar
+// functions in their order (std::max(a, c) == max_ps(c, a); sqrt and div are correctly
+// rounded); the specular power stays std::pow, called per lane (no vector pow is bit-exact).
+// A lane whose gradient is zero keeps its colour. Lanes n..7 are computed but not pow'ed.
+struct ShadeLight {
+    float l[3], v[3], h[3];  // unit vectors: to the light, to the eye, half vector
+    bool h_ok;               // |l + v| > 0 (phong: no specular otherwise; pbr: h = n per lane)
+    float li;                // intensity
+};
+struct PhongLanes {
+    float ambient, diffuse, specular, power;
+};
+struct PbrLanes {
+    float roughness, metallic, ambient;
+};
+
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 dot8(__m256 ax, __m256 ay, __m256 az,
+                                                             const float* b) {
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ax, _mm256_set1_ps(b[0])),
+                                       _mm256_mul_ps(ay, _mm256_set1_ps(b[1]))),
+                         _mm256_mul_ps(az, _mm256_set1_ps(b[2])));
+}
+
+// The normals of normal_from_gradient; the mask of lanes with a non-zero gradient.
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 normals8(const float* gx, const float* gy,
+                                                                 const float* gz, const float* v,
+                                                                 __m256& nx, __m256& ny,
+                                                                 __m256& nz) {
+    const __m256 x = _mm256_loadu_ps(gx), y = _mm256_loadu_ps(gy), z = _mm256_loadu_ps(gz);
+    const __m256 len2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)),
+                                      _mm256_mul_ps(z, z));
+    const __m256 ok = _mm256_cmp_ps(len2, _mm256_setzero_ps(), _CMP_GT_OQ);
+    const __m256 inv = _mm256_div_ps(_mm256_set1_ps(-1.f), _mm256_sqrt_ps(len2));
+    nx = _mm256_mul_ps(x, inv), ny = _mm256_mul_ps(y, inv), nz = _mm256_mul_ps(z, inv);
+    // Facing the viewer: n = -n where dot(n, v) < 0 (a sign flip, exact).
+    const __m256 back = _mm256_cmp_ps(dot8(nx, ny, nz, v), _mm256_setzero_ps(), _CMP_LT_OQ);
+    const __m256 sign = _mm256_and_ps(back, _mm256_set1_ps(-0.f));
+    nx = _mm256_xor_ps(nx, sign), ny = _mm256_xor_ps(ny, sign), nz = _mm256_xor_ps(nz, sign);
+    return ok;
+}
+
+// r, g, b in place: the shaded colours of lanes < n.
+LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const float* gx,
+                               const float* gy, const float* gz, float* r, float* g, float* b,
+                               int n) {
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 nx, ny, nz;
+    const __m256 ok = normals8(gx, gy, gz, L.v, nx, ny, nz);
+    const __m256 ndl = _mm256_max_ps(zero, dot8(nx, ny, nz, L.l));
+    alignas(32) float spec[8] = {};
+    if (L.h_ok) {
+        alignas(32) float ndh[8], lit[8];
+        _mm256_store_ps(ndh, _mm256_max_ps(zero, dot8(nx, ny, nz, L.h)));
+        _mm256_store_ps(lit, _mm256_and_ps(ok, _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ)));
+        for (int j = 0; j < n; ++j)
+            if (lit[j] != 0.f) spec[j] = std::pow(ndh[j], p.power);
+    }
+    const __m256 vli = _mm256_set1_ps(L.li);
+    const __m256 k = _mm256_add_ps(_mm256_set1_ps(p.ambient),
+                                   _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.diffuse), vli), ndl));
+    const __m256 sp = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.specular), vli), _mm256_load_ps(spec));
+    float* c[3] = {r, g, b};
+    for (int i = 0; i < 3; ++i) {
+        const __m256 in = _mm256_loadu_ps(c[i]);
+        _mm256_storeu_ps(c[i], _mm256_blendv_ps(in, _mm256_add_ps(_mm256_mul_ps(in, k), sp), ok));
+    }
+}
+
+// pbr_h for a fixed half vector (callers fall back to the scalar pbr() when !L.h_ok).
+LACUNA_AVX2 inline void pbr8(const PbrLanes& p, const ShadeLight& L, const float* gx,
+                             const float* gy, const float* gz, float* r, float* g, float* b) {
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.f);
+    __m256 nx, ny, nz;
+    const __m256 ok = normals8(gx, gy, gz, L.v, nx, ny, nz);
+    // Per-ray scalars, as pbr_h and its helpers compute them.
+    const float rough = std::clamp(p.roughness, 0.02f, 1.f);
+    const float alpha = rough * rough;
+    const float ldh = std::max(L.l[0] * L.h[0] + L.l[1] * L.h[1] + L.l[2] * L.h[2], 0.f);
+    const float fd90 = 0.5f + 2.f * ldh * ldh * rough;
+    const float a2 = alpha * alpha;
+    const float m = std::clamp(p.metallic, 0.f, 1.f);
+    const __m256 ndl = _mm256_max_ps(zero, dot8(nx, ny, nz, L.l));
+    const __m256 ndv = _mm256_max_ps(_mm256_set1_ps(1e-4f), dot8(nx, ny, nz, L.v));
+    const __m256 ndh = _mm256_max_ps(zero, dot8(nx, ny, nz, L.h));
+    // disney_diffuse
+    const __m256 fd1 = _mm256_set1_ps(fd90 - 1.f);
+    const __m256 lv = _mm256_sub_ps(one, ndl), vv = _mm256_sub_ps(one, ndv);
+    __m256 fl = _mm256_mul_ps(fd1, lv), fv = _mm256_mul_ps(fd1, vv);
+    for (int i = 0; i < 4; ++i) fl = _mm256_mul_ps(fl, lv), fv = _mm256_mul_ps(fv, vv);
+    fl = _mm256_add_ps(one, fl), fv = _mm256_add_ps(one, fv);
+    const __m256 vli = _mm256_set1_ps(L.li);
+    const __m256 diffuse = _mm256_mul_ps(_mm256_mul_ps(vli, _mm256_mul_ps(fl, fv)), ndl);
+    // ggx_d
+    const __m256 d = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(ndh, ndh), _mm256_set1_ps(a2 - 1.f)), one);
+    const __m256 kpi = _mm256_set1_ps(3.14159265358979f);
+    const __m256 D = _mm256_div_ps(_mm256_set1_ps(a2), _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(kpi, d), d),
+                                                                     _mm256_set1_ps(1e-7f)));
+    // smith_joint_ggx_v
+    const __m256 one_a2 = _mm256_set1_ps(1.f - a2), va2 = _mm256_set1_ps(a2);
+    const __m256 gl = _mm256_mul_ps(
+        ndv, _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(ndl, ndl), one_a2), va2)));
+    const __m256 gv = _mm256_mul_ps(
+        ndl, _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(ndv, ndv), one_a2), va2)));
+    const __m256 V = _mm256_div_ps(_mm256_set1_ps(0.5f),
+                                   _mm256_add_ps(_mm256_add_ps(gl, gv), _mm256_set1_ps(1e-5f)));
+    const __m256 spec_common =
+        _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(vli, kpi), D), V), ndl);
+    // Per channel: f0, kd, schlick.
+    const __m256 vm = _mm256_set1_ps(m), one_m = _mm256_set1_ps(1.f - m);
+    const __m256 f0c = _mm256_set1_ps(0.04f * (1.f - m));
+    const __m256 sm = _mm256_set1_ps(1.f - ldh);
+    const __m256 amb_diff = _mm256_add_ps(_mm256_set1_ps(p.ambient), diffuse);
+    float* c[3] = {r, g, b};
+    for (int i = 0; i < 3; ++i) {
+        const __m256 in = _mm256_loadu_ps(c[i]);
+        const __m256 f0 = _mm256_add_ps(f0c, _mm256_mul_ps(in, vm));
+        const __m256 kd = _mm256_mul_ps(in, one_m);
+        __m256 fs = _mm256_sub_ps(one, f0);
+        for (int q = 0; q < 5; ++q) fs = _mm256_mul_ps(fs, sm);
+        const __m256 F = _mm256_add_ps(f0, fs);
+        const __m256 out = _mm256_add_ps(_mm256_mul_ps(kd, amb_diff), _mm256_mul_ps(spec_common, F));
+        _mm256_storeu_ps(c[i], _mm256_blendv_ps(in, out, ok));
+    }
 }
 
 #endif  // LACUNA_SIMD_X86

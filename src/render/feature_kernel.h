@@ -286,16 +286,23 @@ inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g,
 
 // ---- The batched composite ray (the SIMD paths; composite_ray above is the reference) --------
 //
-// The samples of composite_ray, kShadeBatch at a time across the cursor's runs (as
-// kernel::RayStream queues them): (1) positions from k, and the trilinear values of the whole
-// batch in SIMD lanes; (2) per sample, in order, the clip test, the side and the TF entry, and
-// the samples with non-zero opacity collected; (3) the gradients of those, in SIMD lanes; (4) in
-// k order, shading and front-to-back compositing up to early termination. Every quantity is the
-// one composite_ray computes for the same sample, with the same operations (core/simd_shading.h
-// for the lanes; for head and directional lights the half vector once per ray, by the function
-// phong() and pbr() call per sample), and the composited samples and their order are the same,
-// so the bits are the same. Work past the terminating sample (values and gradients of the rest
-// of its batch) is discarded, never composited or counted. Shadows stay on composite_ray.
+// composite_ray's samples in two queues. Lattice samples are queued kShadeBatch at a time across
+// the cursor's runs (as kernel::RayStream queues them); a full queue gets its positions and
+// trilinear values in SIMD lanes, then, per sample in k order, the clip test, the side, the TF
+// entry and - for a sample with non-zero opacity - the opacity chain w = 1 - A, A += w * a with
+// early termination. Opacity does not depend on the gradient (gradient opacity stays on
+// composite_ray), so the chain finds the terminating sample before any gradient is taken, and
+// the visible samples up to it go to the second queue with their w and a. A full visible queue
+// (or the ray's end) gets its gradients in SIMD lanes, then shading and the colour chains
+// C += w * rgb * a in k order.
+//
+// Every quantity is the one composite_ray computes for the same sample with the same operations
+// (core/simd_shading.h for the lanes; for head and directional lights the half vector once per
+// ray, by the function phong() and pbr() call per sample), each of the four accumulation chains
+// sees the same terms in the same order, and the counted samples are the same, so the bits are
+// the same. Work past the terminating sample (the values of the rest of its lattice batch) is
+// discarded, never composited or counted; no gradient is taken for a sample that is not
+// composited. Shadows and gradient opacity stay on composite_ray.
 inline constexpr int kShadeBatch = 8;
 
 // Lane operations of one ISA path over kShadeBatch positions: trilinear values, on-the-fly
@@ -306,7 +313,12 @@ struct ShadeOps;
 #if LACUNA_SIMD_X86 && defined(__SSE4_1__)
 template <>
 struct ShadeOps<4> {
-    // mask: bit l = slot l needs its gradient; a half without any is not computed.
+    static constexpr bool kShades = false;  // scalar shading (phong_h, pbr_h)
+    static void phong(const simd::PhongLanes&, const simd::ShadeLight&, const float*, const float*,
+                      const float*, float*, float*, float*, int) {}
+    static void pbr(const simd::PbrLanes&, const simd::ShadeLight&, const float*, const float*,
+                    const float*, float*, float*, float*) {}
+    // Gradients of the first n positions (four at a time).
     template <class T>
     static void samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
                         const int32_t* k, float* x, float* y, float* z, float* v, int n) {
@@ -314,22 +326,29 @@ struct ShadeOps<4> {
     }
     template <class T>
     static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
-                          const float* z, float* gx, float* gy, float* gz, unsigned mask) {
-        for (int l = 0; l < kShadeBatch; l += 4)
-            if (mask >> l & 15u) simd::gradients4(g, d, x + l, y + l, z + l, gx + l, gy + l, gz + l);
+                          const float* z, float* gx, float* gy, float* gz, int n) {
+        for (int l = 0; l < n; l += 4) simd::gradients4(g, d, x + l, y + l, z + l, gx + l, gy + l, gz + l);
     }
     static void volume_gradients(const simd::ShadeGrid& g, const float* const grad[3],
                                  const float* x, const float* y, const float* z, float* gx,
-                                 float* gy, float* gz, unsigned mask) {
-        for (int l = 0; l < kShadeBatch; l += 4)
-            if (mask >> l & 15u)
-                simd::volume_gradients4(g, grad, x + l, y + l, z + l, gx + l, gy + l, gz + l);
+                                 float* gy, float* gz, int n) {
+        for (int l = 0; l < n; l += 4)
+            simd::volume_gradients4(g, grad, x + l, y + l, z + l, gx + l, gy + l, gz + l);
     }
 };
 #endif
 #if LACUNA_SIMD_X86
 template <>
 struct ShadeOps<8> {
+    static constexpr bool kShades = true;  // simd::phong8, simd::pbr8
+    static void phong(const simd::PhongLanes& p, const simd::ShadeLight& L, const float* gx,
+                      const float* gy, const float* gz, float* r, float* g, float* b, int n) {
+        simd::phong8(p, L, gx, gy, gz, r, g, b, n);
+    }
+    static void pbr(const simd::PbrLanes& p, const simd::ShadeLight& L, const float* gx,
+                    const float* gy, const float* gz, float* r, float* g, float* b) {
+        simd::pbr8(p, L, gx, gy, gz, r, g, b);
+    }
     template <class T>
     static void samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
                         const int32_t* k, float* x, float* y, float* z, float* v, int) {
@@ -337,12 +356,12 @@ struct ShadeOps<8> {
     }
     template <class T>
     static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
-                          const float* z, float* gx, float* gy, float* gz, unsigned) {
+                          const float* z, float* gx, float* gy, float* gz, int) {
         simd::gradients8(g, d, x, y, z, gx, gy, gz);
     }
     static void volume_gradients(const simd::ShadeGrid& g, const float* const grad[3],
                                  const float* x, const float* y, const float* z, float* gx,
-                                 float* gy, float* gz, unsigned) {
+                                 float* gy, float* gz, int) {
         simd::volume_gradients8(g, grad, x, y, z, gx, gy, gz);
     }
 };
@@ -366,7 +385,8 @@ public:
           m_sg(sg),
           m_sr{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}, t_base, c.dt},
           m_view(view),
-          m_acc(acc) {
+          m_acc(acc),
+          m_alpha(acc.a) {
         // Head and directional lights: l, li and the half vector are those of every sample.
         const Light& L = c.f->light;
         m_fixed_light = L.kind != LightKind::Spot;
@@ -374,7 +394,13 @@ public:
             m_l = L.kind == LightKind::Head ? view : c.light_dir;
             m_li = L.intensity;
             m_h_ok = shading::half_vector(m_l, view, m_h);
+            m_lanes_light = {{m_l.x, m_l.y, m_l.z}, {view.x, view.y, view.z}, {m_h.x, m_h.y, m_h.z},
+                             m_h_ok, m_li};
         }
+        // Whole batches shaded in lanes: a fixed light, and for PBR a half vector.
+        m_lane_shading = Ops::kShades && c.need_gradient && m_fixed_light &&
+                         (c.f->shading == ShadingModel::Phong ||
+                          (c.f->shading == ShadingModel::Pbr && m_h_ok));
     }
 
     // Queues the samples [kb, ke); false once the ray is opaque.
@@ -384,103 +410,115 @@ public:
             for (int l = 0; l < take; ++l) m_k[m_m + l] = kb + l;
             m_m += take;
             kb += take;
-            if (m_m == kShadeBatch && !flush()) return false;
+            if (m_m == kShadeBatch) {
+                flush_lattice();
+                if (m_done) return false;
+            }
         }
-        return !m_done;
+        return true;
     }
+    // Evaluates what is still queued; the accumulator is complete afterwards.
     void finish() {
-        if (m_m > 0 && !m_done) flush();
-        m_m = 0;
+        if (m_m > 0 && !m_done) flush_lattice();
+        if (m_nv > 0) flush_visible();
+        m_acc.a = m_alpha;
     }
     uint32_t samples() const { return m_n; }
 
 private:
-    bool flush() {
+    // The m_m queued lattice samples (composite_ray's steps 1, 2 and the opacity chain of 4).
+    void flush_lattice() {
         const Context& c = m_c;
-        const FeatureOptions& f = *c.f;
         const int m = m_m;
         m_m = 0;
-        // 1. Positions (composite_ray's step 1) and values; the batch is padded with its last
-        // sample.
-        for (int l = m; l < kShadeBatch; ++l) m_k[l] = m_k[m - 1];
+        for (int l = m; l < kShadeBatch; ++l) m_k[l] = m_k[m - 1];  // padding
         alignas(32) float x[kShadeBatch], y[kShadeBatch], z[kShadeBatch], v[kShadeBatch];
         Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, m);
-        // 2. Clip test, side, TF entry; which slots are visible.
-        enum : uint8_t { kClipped, kClear, kVisible };
-        uint8_t kind[kShadeBatch];
-        int side[kShadeBatch], entry[kShadeBatch];
-        unsigned visible = 0;
         for (int l = 0; l < m; ++l) {
-            if (!c.kept(x[l], y[l], z[l])) {
-                kind[l] = kClipped;
-                continue;
-            }
-            side[l] = c.side(x[l], y[l], z[l]);
-            entry[l] = c.map(v[l]);
-            if (!(c.raw[side[l]][entry[l]].a > 0.f)) {
-                kind[l] = kClear;
-                continue;
-            }
-            kind[l] = kVisible;
-            visible |= 1u << l;
-        }
-        // 3. Gradients at the batch's positions (used for the visible slots only).
-        alignas(32) float gx[kShadeBatch], gy[kShadeBatch], gz[kShadeBatch];
-        if (visible && c.need_gradient) {
-            if (c.grad[0])
-                Ops::volume_gradients(m_sg, c.grad, x, y, z, gx, gy, gz, visible);
-            else
-                Ops::gradients(m_sg, m_data, x, y, z, gx, gy, gz, visible);
-        }
-        // 4. In k order: count, shade and composite (composite_ray's steps 2-4).
-        kernel::Accum acc = m_acc;
-        for (int l = 0; l < m; ++l) {
-            if (kind[l] == kClipped) continue;
+            if (!c.kept(x[l], y[l], z[l])) continue;
             ++m_n;
-            if (kind[l] == kClear) continue;
-            const int j = l;
-            const Rgba& raw = c.raw[side[l]][entry[l]];
-            float a = c.corr[side[l]][entry[l]].a;
+            const int s = c.side(x[l], y[l], z[l]);
+            const int e = c.map(v[l]);
+            if (!(c.raw[s][e].a > 0.f)) continue;
+            const float a = c.corr[s][e].a;
+            const float w = 1.f - m_alpha;
+            m_alpha += w * a;
+            const int j = m_nv++;
+            m_vx[j] = x[l], m_vy[j] = y[l], m_vz[j] = z[l];
+            m_vrgb[j] = &c.raw[s][e];
+            m_vw[j] = w, m_va[j] = a;
+            if (m_nv == kShadeBatch) flush_visible();
+            if (m_alpha >= c.ert) {
+                m_done = true;
+                return;
+            }
+        }
+    }
+
+    // The queued visible samples: gradients, shading, the colour chains of step 4.
+    void flush_visible() {
+        const Context& c = m_c;
+        const FeatureOptions& f = *c.f;
+        const int nv = m_nv;
+        m_nv = 0;
+        alignas(32) float gx[kShadeBatch], gy[kShadeBatch], gz[kShadeBatch];
+        if (c.need_gradient) {
+            for (int j = nv; j < kShadeBatch; ++j)  // padding
+                m_vx[j] = m_vx[nv - 1], m_vy[j] = m_vy[nv - 1], m_vz[j] = m_vz[nv - 1];
+            if (c.grad[0])
+                Ops::volume_gradients(m_sg, c.grad, m_vx, m_vy, m_vz, gx, gy, gz, nv);
+            else
+                Ops::gradients(m_sg, m_data, m_vx, m_vy, m_vz, gx, gy, gz, nv);
+        }
+        kernel::Accum acc = m_acc;
+        if (m_lane_shading) {
+            alignas(32) float r[kShadeBatch], g[kShadeBatch], b[kShadeBatch];
+            for (int j = 0; j < kShadeBatch; ++j) {
+                const Rgba& raw = *m_vrgb[std::min(j, nv - 1)];
+                r[j] = raw.r, g[j] = raw.g, b[j] = raw.b;
+            }
+            if (f.shading == ShadingModel::Phong)
+                Ops::phong({f.phong.ambient, f.phong.diffuse, f.phong.specular, f.phong.power},
+                           m_lanes_light, gx, gy, gz, r, g, b, nv);
+            else
+                Ops::pbr({f.pbr.roughness, f.pbr.metallic, f.pbr.ambient}, m_lanes_light, gx, gy,
+                         gz, r, g, b);
+            for (int j = 0; j < nv; ++j) {
+                const float w = m_vw[j], a = m_va[j];
+                acc.r += w * r[j] * a;
+                acc.g += w * g[j] * a;
+                acc.b += w * b[j] * a;
+            }
+            m_acc = acc;
+            return;
+        }
+        for (int j = 0; j < nv; ++j) {
+            const Rgba& raw = *m_vrgb[j];
             Vec3f rgb{raw.r, raw.g, raw.b};
-            if (c.need_gradient) {
-                const Vec3f grad{gx[j], gy[j], gz[j]};
-                if (f.gradient_opacity.enabled) {
-                    const float am = std::min(raw.a, 1.f) *
-                                     shading::gradient_opacity(f.gradient_opacity, length(grad));
-                    if (!(am > 0.f)) continue;
-                    a = 1.f - std::pow(1.f - am, c.step);
-                }
-                Vec3f nrm;
-                if (f.shading != ShadingModel::None &&
-                    shading::normal_from_gradient(grad, m_view, nrm)) {
-                    if (m_fixed_light) {
-                        rgb = f.shading == ShadingModel::Phong
-                                  ? shading::phong_h(f.phong, rgb, nrm, m_l, m_h, m_h_ok, m_li)
-                                  : shading::pbr_h(f.pbr, rgb, nrm, m_l, m_view,
-                                                   m_h_ok ? m_h : nrm, m_li);
-                    } else {
-                        const Vec3f pw = Vec3f{x[l], y[l], z[l]} * c.sp;
-                        Vec3f lt;
-                        float li, dist;
-                        light_at(c, pw, m_view, lt, li, dist);
-                        rgb = f.shading == ShadingModel::Phong
-                                  ? shading::phong(f.phong, rgb, nrm, lt, m_view, li)
-                                  : shading::pbr(f.pbr, rgb, nrm, lt, m_view, li);
-                    }
+            Vec3f nrm;
+            if (f.shading != ShadingModel::None &&
+                shading::normal_from_gradient({gx[j], gy[j], gz[j]}, m_view, nrm)) {
+                if (m_fixed_light) {
+                    rgb = f.shading == ShadingModel::Phong
+                              ? shading::phong_h(f.phong, rgb, nrm, m_l, m_h, m_h_ok, m_li)
+                              : shading::pbr_h(f.pbr, rgb, nrm, m_l, m_view, m_h_ok ? m_h : nrm,
+                                               m_li);
+                } else {
+                    const Vec3f pw = Vec3f{m_vx[j], m_vy[j], m_vz[j]} * c.sp;
+                    Vec3f lt;
+                    float li, dist;
+                    light_at(c, pw, m_view, lt, li, dist);
+                    rgb = f.shading == ShadingModel::Phong
+                              ? shading::phong(f.phong, rgb, nrm, lt, m_view, li)
+                              : shading::pbr(f.pbr, rgb, nrm, lt, m_view, li);
                 }
             }
-            const float w = 1.f - acc.a;
+            const float w = m_vw[j], a = m_va[j];
             acc.r += w * rgb.x * a;
             acc.g += w * rgb.y * a;
             acc.b += w * rgb.z * a;
-            acc.a += w * a;
-            if (acc.a >= c.ert) {
-                m_done = true;
-                break;
-            }
         }
         m_acc = acc;
-        return !m_done;
     }
 
     const Context& m_c;
@@ -488,12 +526,18 @@ private:
     const simd::ShadeGrid& m_sg;
     simd::ShadeRay m_sr;
     Vec3f m_view;
-    kernel::Accum& m_acc;
-    bool m_fixed_light = false, m_h_ok = false, m_done = false;
+    kernel::Accum& m_acc;   // r, g, b; a is m_alpha until finish()
+    float m_alpha;
+    bool m_fixed_light = false, m_h_ok = false, m_done = false, m_lane_shading = false;
     Vec3f m_l{0, 0, 1}, m_h{0, 0, 1};
+    simd::ShadeLight m_lanes_light{};
     float m_li = 0.f;
-    alignas(32) int32_t m_k[kShadeBatch];
+    alignas(32) int32_t m_k[kShadeBatch];  // lattice queue
     int m_m = 0;
+    alignas(32) float m_vx[kShadeBatch], m_vy[kShadeBatch], m_vz[kShadeBatch];  // visible queue
+    float m_vw[kShadeBatch], m_va[kShadeBatch];
+    const Rgba* m_vrgb[kShadeBatch];
+    int m_nv = 0;
     uint32_t m_n = 0;
 };
 
@@ -558,8 +602,9 @@ inline uint32_t average_ray(const Context& c, const kernel::Grid<T, Index>& g, C
 // One tile of the feature path: per pixel, the ray, its (jittered) lattice, the cursor of the
 // blend mode, and the pixel.
 //
-// Ops: ShadeOps<W> of the active SIMD path, run for composite rays without shadows through
-// ShadedStream (`sg` is then the grid's int32 geometry); void: composite_ray, the reference.
+// Ops: ShadeOps<W> of the active SIMD path, run for composite rays without shadows or gradient
+// opacity through ShadedStream (`sg` is then the grid's int32 geometry); void: composite_ray,
+// the reference.
 template <class Ops, class T, class Index, class S>
 void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>& g,
                  const simd::ShadeGrid& sg, const Camera& cam, const RenderOptions& opt, int x0,

@@ -206,12 +206,12 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
                 c.inv_stride = 1.f / float(stride);
                 out.stats.light_volume_bytes = m_cache->light.size() * sizeof(float);
             }
-            // 5. The frame: composite rays without shadows on the batched SIMD path of the
+            // 5. The frame: composite rays without shadows or gradient opacity on the batched SIMD path of the
             // active ISA (int32 offsets: grids under 2^31 voxels), the rest one sample at a
             // time (feature::composite_ray, the reference; also the scalar ISA path).
             const int dims[3] = {d.x, d.y, d.z};
             const simd::ShadeGrid sg = feature::shade_grid(c, dims);
-            const bool batched = composite && !f.shadows.enabled &&
+            const bool batched = composite && !f.shadows.enabled && !f.gradient_opacity.enabled &&
                                  m_volume.voxel_count() < (size_t(1) << 31);
             auto frame = [&](auto ops) {
                 using Ops = typename decltype(ops)::type;
