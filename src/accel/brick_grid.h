@@ -199,7 +199,14 @@ public:
 
     bool next(Segment& out) {
         Step s;
-        while (step<false>(s)) {
+        while (m_t < m_far) {
+            // Runs of brick steps inside non-empty blocks go through the register-resident
+            // walk; an empty block (a leap) through step().
+            if (m_g.m_words[size_t(m_blk)] != 0) {
+                if (brick_run(out)) return true;
+                continue;
+            }
+            step<false>(s);
             if (s.occupied) {
                 bool emit = false;
                 if (!m_open) {
@@ -226,6 +233,63 @@ public:
         m_open = false;
         out = {m_start, m_gap ? m_gap_start : m_far};
         return out.t1 > out.t0;
+    }
+
+    // Brick steps while the ray stays in non-empty blocks, with the walk state in registers and
+    // the axis chosen without branches (the choice is data dependent: a branch on it
+    // mispredicts about every other step). The same walk as step<false>() and the same
+    // run/gap bookkeeping as next(); true when it hands out a segment.
+    bool brick_run(Segment& out) {
+        const int L = m_g.m_log2;
+        const uint64_t* words = m_g.m_words.data();
+        float t = m_t, n0 = m_next[0], n1 = m_next[1], n2 = m_next[2];
+        int b0 = m_b[0], b1 = m_b[1], b2 = m_b[2], bit = m_bit;
+        int64_t blk = m_blk;
+        bool emit = false;
+        while (t < m_far) {
+            const uint64_t w = words[size_t(blk)];
+            if (w == 0) break;
+            const bool occupied = (w >> bit) & 1u;
+            const bool x = n0 <= n1 && n0 <= n2, y = !x && n1 <= n2, z = !x && !y;
+            const float te = x ? n0 : (y ? n1 : n2);
+            const float t1 = std::max(std::min(te, m_far), t);
+            if (occupied) {
+                if (!m_open) {
+                    m_open = true;
+                    m_start = t;
+                } else if (m_gap && t - m_gap_start > m_min_skip) {
+                    out = {m_start, m_gap_start};
+                    m_start = t;
+                    emit = out.t1 > out.t0;
+                }
+                m_gap = false;
+                if (!emit && t1 - m_start >= m_chunk && t1 < m_far) {
+                    out = {m_start, t1};
+                    m_start = t1;
+                    emit = true;
+                }
+            } else if (m_open && !m_gap) {
+                m_gap = true;
+                m_gap_start = t;
+            }
+            t = t1;
+            // Advance the chosen axis: brick, block, bit and its next crossing.
+            const int a = x ? 0 : (y ? 1 : 2);
+            const int ob = x ? b0 : (y ? b1 : b2), nb = ob + m_step[a];
+            const bool wrap = (nb >> 2) != (ob >> 2);
+            blk += wrap ? m_blk_delta[a] : 0;
+            bit += wrap ? m_bit_wrap[a] : m_bit_delta[a];
+            const float nt = crossing(a, nb, L);
+            b0 = x ? nb : b0, b1 = y ? nb : b1, b2 = z ? nb : b2;
+            n0 = x ? nt : n0, n1 = y ? nt : n1, n2 = z ? nt : n2;
+            if (emit) break;
+        }
+        m_t = t;
+        m_next[0] = n0, m_next[1] = n1, m_next[2] = n2;
+        m_b[0] = b0, m_b[1] = b1, m_b[2] = b2;
+        m_bit = bit;
+        m_blk = blk;
+        return emit;
     }
 
 private:
