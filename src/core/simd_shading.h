@@ -29,6 +29,8 @@ struct ShadeGrid {
     int32_t cell[3];   // dims - 2
     int32_t sy, sz;    // strides of j and k
     float inv_sp[3];   // 1 / spacing: index-space differences -> values per mm
+    float lut_offset, lut_scale, lut_last;  // ValueToLut
+    const float* alpha;  // TF opacities, every 4th float (&Rgba::a of the front LUT)
 };
 
 // One ray's sample lattice in index space: sample k at o + t*d, t = t_base + (k + 0.5)*dt
@@ -75,20 +77,31 @@ inline __m128 trilinear4(const ShadeGrid& g, const T* data, __m128 x, __m128 y, 
     return lerp(c0, c1, f[2]);
 }
 
-// The positions of lattice samples k[0..3] into x, y, z, and their trilinear values into v.
+// The positions of lattice samples k[0..3] into x, y, z, their trilinear values into v, their
+// LUT entries (ValueToLut) into e; returns the mask of lanes whose TF opacity (g.alpha) is > 0.
 template <class T>
-inline void samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
-                     float* x, float* y, float* z, float* v) {
+inline int samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
+                    float* x, float* y, float* z, float* v, int32_t* e) {
+    const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
     const __m128 t = _mm_add_ps(
         _mm_set1_ps(r.t_base),
-        _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k))),
-                              _mm_set1_ps(0.5f)),
+        _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k))), half),
                    _mm_set1_ps(r.dt)));
     const __m128 px = _mm_add_ps(_mm_set1_ps(r.o[0]), _mm_mul_ps(t, _mm_set1_ps(r.d[0])));
     const __m128 py = _mm_add_ps(_mm_set1_ps(r.o[1]), _mm_mul_ps(t, _mm_set1_ps(r.d[1])));
     const __m128 pz = _mm_add_ps(_mm_set1_ps(r.o[2]), _mm_mul_ps(t, _mm_set1_ps(r.d[2])));
     _mm_storeu_ps(x, px), _mm_storeu_ps(y, py), _mm_storeu_ps(z, pz);
-    _mm_storeu_ps(v, trilinear4(g, data, px, py, pz));
+    const __m128 val = trilinear4(g, data, px, py, pz);
+    _mm_storeu_ps(v, val);
+    __m128 u = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(val, _mm_set1_ps(g.lut_offset)), _mm_set1_ps(g.lut_scale)), half);
+    u = _mm_max_ps(zero, _mm_min_ps(_mm_set1_ps(g.lut_last), u));
+    const __m128i ent = _mm_cvttps_epi32(u);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(e), ent);
+    const __m128 a = _mm_setr_ps(g.alpha[4 * ptrdiff_t(_mm_extract_epi32(ent, 0))],
+                                 g.alpha[4 * ptrdiff_t(_mm_extract_epi32(ent, 1))],
+                                 g.alpha[4 * ptrdiff_t(_mm_extract_epi32(ent, 2))],
+                                 g.alpha[4 * ptrdiff_t(_mm_extract_epi32(ent, 3))]);
+    return _mm_movemask_ps(_mm_cmpgt_ps(a, zero));
 }
 
 // Central differences of trilinear samples one voxel to either side, in values per mm
@@ -213,19 +226,27 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const ShadeG
 
 // samples4's eight-lane twin.
 template <class T>
-LACUNA_AVX2 void samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
-                          float* x, float* y, float* z, float* v) {
+LACUNA_AVX2 int samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
+                         float* x, float* y, float* z, float* v, int32_t* e) {
+    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
     const __m256 t = _mm256_add_ps(
         _mm256_set1_ps(r.t_base),
         _mm256_mul_ps(
-            _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k))),
-                          _mm256_set1_ps(0.5f)),
+            _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k))), half),
             _mm256_set1_ps(r.dt)));
     const __m256 px = _mm256_add_ps(_mm256_set1_ps(r.o[0]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[0])));
     const __m256 py = _mm256_add_ps(_mm256_set1_ps(r.o[1]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[1])));
     const __m256 pz = _mm256_add_ps(_mm256_set1_ps(r.o[2]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[2])));
     _mm256_storeu_ps(x, px), _mm256_storeu_ps(y, py), _mm256_storeu_ps(z, pz);
-    _mm256_storeu_ps(v, trilinear8(g, data, px, py, pz));
+    const __m256 val = trilinear8(g, data, px, py, pz);
+    _mm256_storeu_ps(v, val);
+    __m256 u = _mm256_add_ps(
+        _mm256_mul_ps(_mm256_sub_ps(val, _mm256_set1_ps(g.lut_offset)), _mm256_set1_ps(g.lut_scale)), half);
+    u = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.lut_last), u));
+    const __m256i ent = _mm256_cvttps_epi32(u);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(e), ent);
+    const __m256 a = _mm256_i32gather_ps(g.alpha, _mm256_slli_epi32(ent, 2), 4);
+    return _mm256_movemask_ps(_mm256_cmp_ps(a, zero, _CMP_GT_OQ));
 }
 
 // gradients4's eight-lane twin.

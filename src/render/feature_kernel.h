@@ -320,9 +320,12 @@ struct ShadeOps<4> {
                     const float*, float*, float*, float*) {}
     // Gradients of the first n positions (four at a time).
     template <class T>
-    static void samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
-                        const int32_t* k, float* x, float* y, float* z, float* v, int n) {
-        for (int l = 0; l < n; l += 4) simd::samples4(g, r, d, k + l, x + l, y + l, z + l, v + l);
+    static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
+                            const int32_t* k, float* x, float* y, float* z, float* v,
+                            int32_t* e, int n) {
+        unsigned mask = unsigned(simd::samples4(g, r, d, k, x, y, z, v, e));
+        if (n > 4) mask |= unsigned(simd::samples4(g, r, d, k + 4, x + 4, y + 4, z + 4, v + 4, e + 4)) << 4;
+        return mask;
     }
     template <class T>
     static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
@@ -350,9 +353,10 @@ struct ShadeOps<8> {
         simd::pbr8(p, L, gx, gy, gz, r, g, b);
     }
     template <class T>
-    static void samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
-                        const int32_t* k, float* x, float* y, float* z, float* v, int) {
-        simd::samples8(g, r, d, k, x, y, z, v);
+    static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
+                            const int32_t* k, float* x, float* y, float* z, float* v,
+                            int32_t* e, int) {
+        return unsigned(simd::samples8(g, r, d, k, x, y, z, v, e));
     }
     template <class T>
     static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
@@ -372,7 +376,11 @@ inline simd::ShadeGrid shade_grid(const Context& c, const int dims[3]) {
             {dims[0] - 2, dims[1] - 2, dims[2] - 2},
             int32_t(dims[0]),
             int32_t(dims[0]) * int32_t(dims[1]),
-            {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z}};
+            {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z},
+            c.map.offset(),
+            c.map.scale(),
+            float(c.map.last()),
+            &c.raw[0][0].a};
 }
 
 template <class T, class Ops>
@@ -397,6 +405,7 @@ public:
             m_lanes_light = {{m_l.x, m_l.y, m_l.z}, {view.x, view.y, view.z}, {m_h.x, m_h.y, m_h.z},
                              m_h_ok, m_li};
         }
+        m_plain = !c.two_tfs && c.n_clips == 0 && !c.f->crop;
         // Whole batches shaded in lanes: a fixed light, and for PBR a half vector.
         m_lane_shading = Ops::kShades && c.need_gradient && m_fixed_light &&
                          (c.f->shading == ShadingModel::Phong ||
@@ -433,26 +442,43 @@ private:
         m_m = 0;
         for (int l = m; l < kShadeBatch; ++l) m_k[l] = m_k[m - 1];  // padding
         alignas(32) float x[kShadeBatch], y[kShadeBatch], z[kShadeBatch], v[kShadeBatch];
-        Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, m);
+        alignas(32) int32_t e[kShadeBatch];  // c.map(v), in lanes
+        unsigned visible = Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, e, m) & ((1u << m) - 1u);
+        if (m_plain) {
+            // Every sample kept, one TF: the lanes' opacity mask says which are visible.
+            int counted = m;
+            while (visible) {
+                const int l = __builtin_ctz(visible);
+                visible &= visible - 1u;
+                if (push(x[l], y[l], z[l], c.raw[0][e[l]], c.corr[0][e[l]].a)) {
+                    counted = l + 1;
+                    break;
+                }
+            }
+            m_n += uint32_t(counted);
+            return;
+        }
         for (int l = 0; l < m; ++l) {
             if (!c.kept(x[l], y[l], z[l])) continue;
             ++m_n;
             const int s = c.side(x[l], y[l], z[l]);
-            const int e = c.map(v[l]);
-            if (!(c.raw[s][e].a > 0.f)) continue;
-            const float a = c.corr[s][e].a;
-            const float w = 1.f - m_alpha;
-            m_alpha += w * a;
-            const int j = m_nv++;
-            m_vx[j] = x[l], m_vy[j] = y[l], m_vz[j] = z[l];
-            m_vrgb[j] = &c.raw[s][e];
-            m_vw[j] = w, m_va[j] = a;
-            if (m_nv == kShadeBatch) flush_visible();
-            if (m_alpha >= c.ert) {
-                m_done = true;
-                return;
-            }
+            if (!(c.raw[s][e[l]].a > 0.f)) continue;
+            if (push(x[l], y[l], z[l], c.raw[s][e[l]], c.corr[s][e[l]].a)) return;
         }
+    }
+
+    // A visible sample with step-corrected opacity a: the opacity chain, the visible queue;
+    // true (and m_done) when the ray is now opaque.
+    bool push(float x, float y, float z, const Rgba& raw, float a) {
+        const float w = 1.f - m_alpha;
+        m_alpha += w * a;
+        const int j = m_nv++;
+        m_vx[j] = x, m_vy[j] = y, m_vz[j] = z;
+        m_vrgb[j] = &raw;
+        m_vw[j] = w, m_va[j] = a;
+        if (m_nv == kShadeBatch) flush_visible();
+        m_done = m_alpha >= m_c.ert;
+        return m_done;
     }
 
     // The queued visible samples: gradients, shading, the colour chains of step 4.
@@ -529,6 +555,7 @@ private:
     kernel::Accum& m_acc;   // r, g, b; a is m_alpha until finish()
     float m_alpha;
     bool m_fixed_light = false, m_h_ok = false, m_done = false, m_lane_shading = false;
+    bool m_plain = false;  // no clip plane, crop box or second TF
     Vec3f m_l{0, 0, 1}, m_h{0, 0, 1};
     simd::ShadeLight m_lanes_light{};
     float m_li = 0.f;
