@@ -304,6 +304,8 @@ inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g,
 // discarded, never composited or counted; no gradient is taken for a sample that is not
 // composited. Shadows and gradient opacity stay on composite_ray.
 inline constexpr int kShadeBatch = 8;
+// Lattice samples per evaluation: two lane batches, whose loads overlap.
+inline constexpr int kLatticeBatch = 2 * kShadeBatch;
 
 // Lane operations of one ISA path over kShadeBatch positions: trilinear values, on-the-fly
 // gradients, gradient-volume lookups. W = 4: SSE4.1 (two calls), W = 8: AVX2 (also the path
@@ -415,11 +417,11 @@ public:
     // Queues the samples [kb, ke); false once the ray is opaque.
     bool add(int kb, int ke) {
         while (kb < ke) {
-            const int take = std::min(ke - kb, kShadeBatch - m_m);
+            const int take = std::min(ke - kb, kLatticeBatch - m_m);
             for (int l = 0; l < take; ++l) m_k[m_m + l] = kb + l;
             m_m += take;
             kb += take;
-            if (m_m == kShadeBatch) {
+            if (m_m == kLatticeBatch) {
                 flush_lattice();
                 if (m_done) return false;
             }
@@ -440,10 +442,16 @@ private:
         const Context& c = m_c;
         const int m = m_m;
         m_m = 0;
-        for (int l = m; l < kShadeBatch; ++l) m_k[l] = m_k[m - 1];  // padding
-        alignas(32) float x[kShadeBatch], y[kShadeBatch], z[kShadeBatch], v[kShadeBatch];
-        alignas(32) int32_t e[kShadeBatch];  // c.map(v), in lanes
-        unsigned visible = Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, e, m) & ((1u << m) - 1u);
+        for (int l = m; l < kLatticeBatch; ++l) m_k[l] = m_k[m - 1];  // padding
+        alignas(32) float x[kLatticeBatch], y[kLatticeBatch], z[kLatticeBatch], v[kLatticeBatch];
+        alignas(32) int32_t e[kLatticeBatch];  // c.map(v), in lanes
+        unsigned visible = Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, e, std::min(m, kShadeBatch));
+        if (m > kShadeBatch)
+            visible |= Ops::samples(m_sg, m_sr, m_data, m_k + kShadeBatch, x + kShadeBatch,
+                                    y + kShadeBatch, z + kShadeBatch, v + kShadeBatch,
+                                    e + kShadeBatch, m - kShadeBatch)
+                       << kShadeBatch;
+        visible &= (1u << m) - 1u;
         if (m_plain) {
             // Every sample kept, one TF: the lanes' opacity mask says which are visible.
             int counted = m;
@@ -559,7 +567,7 @@ private:
     Vec3f m_l{0, 0, 1}, m_h{0, 0, 1};
     simd::ShadeLight m_lanes_light{};
     float m_li = 0.f;
-    alignas(32) int32_t m_k[kShadeBatch];  // lattice queue
+    alignas(32) int32_t m_k[kLatticeBatch];  // lattice queue
     int m_m = 0;
     alignas(32) float m_vx[kShadeBatch], m_vy[kShadeBatch], m_vz[kShadeBatch];  // visible queue
     float m_vw[kShadeBatch], m_va[kShadeBatch];
