@@ -8,7 +8,14 @@ void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
     uint8_t* px = out.image.pixel(x, y);
     const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
                           acc.b + w * opt.background.z};
-    for (int c = 0; c < 3; ++c) px[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
+    for (int c = 0; c < 3; ++c) {
+        // std::lround for x in [0, 255] without the libm call: x - trunc(x) is exact there,
+        // so the half-away-from-zero test is exact too.
+        const float x = std::clamp(rgb[c], 0.f, 1.f) * 255.f;
+        int v = int(x);
+        if (x - float(v) >= 0.5f) ++v;
+        px[c] = uint8_t(v);
+    }
     px[3] = 255;
     const size_t p = size_t(y) * size_t(out.image.width) + size_t(x);
     if (opt.keep_float) {
