@@ -1,6 +1,6 @@
 // The ray marcher's lane kernels: W rays in lockstep, one per SIMD lane, for SSE4.1 (W = 4, the
 // x86-64-v2 baseline), AVX2 (W = 8) and AVX-512 (W = 16), chosen at run time (active_isa()). The
-// only other file with intrinsics is core/simd.h.
+// only file with intrinsics (STYLE.md: SIMD in one place).
 //
 // Why lanes are rays. Front-to-back compositing is a serial chain per ray (w = 1 - a, then
 // a += w * c: a subtract, a multiply and an add of latency, ~10 cycles a sample), so one ray at a
@@ -35,7 +35,9 @@
 
 namespace lacuna::simd {
 
-// Kernel paths, narrowest first. Scalar = the one-ray-at-a-time RayStream with plain loops.
+// Kernel paths, narrowest first. Scalar = one ray at a time with plain loops (kernel::RayStream);
+// the others march lanes of rays. Volumes of 2^31 voxels or more always march one ray at a time
+// (64-bit offsets, plain loops).
 enum class Isa { Scalar, Sse41, Avx2, Avx512 };
 std::string to_string(Isa i);
 // Throws lacuna::Error for an unknown name ("scalar", "sse4.1", "avx2", "avx512").

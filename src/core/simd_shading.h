@@ -1,6 +1,7 @@
 // SIMD helpers of the shaded ray path (src/render/feature_kernel.h, docs/shading.md "Batched
-// shading"): trilinear values and on-the-fly central-difference gradients of a batch of sample
-// positions, one sample per lane. SSE4.1 (4 lanes, the baseline) and AVX2 (8 lanes, through
+// shading"): lattice positions, trilinear values, LUT entries and opacity masks, on-the-fly
+// central-difference and gradient-volume gradients, and Phong / PBR shading of a batch of
+// samples, one sample per lane. SSE4.1 (4 lanes, the baseline) and AVX2 (8 lanes, through
 // __attribute__((target)) like core/simd_lanes.h; run only after simd::isa_supported).
 //
 // Bit-exactness with kernel::trilinear() and feature::gradient(): each lane performs the scalar
@@ -163,20 +164,32 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const ShadeG
     const __m256i o3 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz));
     __m256 c000, c100, c010, c110, c001, c101, c011, c111;
     if constexpr (kByte) {
-        const int* base = reinterpret_cast<const int*>(data);
-        const __m256i w0 = _mm256_i32gather_epi32(base, off, 1);
-        const __m256i w1 = _mm256_i32gather_epi32(base, o1, 1);
-        const __m256i w2 = _mm256_i32gather_epi32(base, o2, 1);
-        const __m256i w3 = _mm256_i32gather_epi32(base, o3, 1);
+        // Corner pairs by 16-bit scalar loads into a small table (cheaper than four gathers
+        // here), then widened: low byte voxel i, high byte voxel i + 1.
+        alignas(32) int32_t o[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(o), off);
+        alignas(16) uint16_t w[4][8];
+        const ptrdiff_t sy = g.sy, sz = g.sz, syz = sy + sz;
+        for (int l = 0; l < 8; ++l) {
+            const T* p = data + o[l];
+            __builtin_memcpy(&w[0][l], p, 2);
+            __builtin_memcpy(&w[1][l], p + sy, 2);
+            __builtin_memcpy(&w[2][l], p + sz, 2);
+            __builtin_memcpy(&w[3][l], p + syz, 2);
+        }
         const __m256i m = _mm256_set1_epi32(0xff);
+        const __m256i w0 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[0])));
+        const __m256i w1 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[1])));
+        const __m256i w2 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[2])));
+        const __m256i w3 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[3])));
         c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
-        c100 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w0, 8), m));
-        c010 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w1, 16), m));
-        c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 24));
-        c001 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w2, 16), m));
-        c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 24));
-        c011 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w3, 16), m));
-        c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 24));
+        c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 8));
+        c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
+        c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 8));
+        c001 = _mm256_cvtepi32_ps(_mm256_and_si256(w2, m));
+        c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 8));
+        c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
+        c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 8));
     } else if constexpr (sizeof(T) == 2) {
         const int* base = reinterpret_cast<const int*>(data);
         const __m256i w0 = _mm256_i32gather_epi32(base, off, 2);

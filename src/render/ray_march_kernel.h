@@ -8,7 +8,6 @@
 #include <type_traits>
 
 #include "lacuna/transfer_function.h"
-#include "core/simd.h"
 
 #if defined(__GNUC__)
 #define LACUNA_ALWAYS_INLINE inline __attribute__((always_inline))
@@ -106,12 +105,14 @@ inline bool intersect_box(const IndexRay& r, const float hi[3], float& t0, float
 // last partial batch is padded (its extra lanes repeat the last index and are never composited).
 //
 // Every sample's position comes from its own k, with the arithmetic of trilinear() (same IEEE
-// operations in the same order, no fma contraction: SSE4.1 lanes in core/simd.h for int32
-// offsets, plain loops otherwise), so the result is that of one sample at a time, to the bit,
+// operations in the same order, no fma contraction, plain loops), so the result is that of one
+// sample at a time, to the bit,
 // however the runs fall. Samples of a batch past an early termination are computed but never
 // composited or counted.
 inline constexpr int kBatch = 8;
 
+// The one-ray-at-a-time reference path (LACUNA_ISA=scalar, and volumes of 2^31 voxels or more);
+// the SIMD paths run several rays per instruction instead (core/simd_lanes.h).
 template <class T, class Index>
 class RayStream {
 public:
@@ -119,21 +120,6 @@ public:
               ValueToLut map, float ert, Accum& acc)
         : m_g(g), m_r(r), m_t_base(t_base), m_dt(dt), m_lut(lut), m_map(map), m_ert(ert),
           m_acc(acc) {
-#if LACUNA_SIMD_SSE41
-        if constexpr (kSimd) {
-            m_sg = simd::Sample4Grid{{r.ox, r.oy, r.oz},
-                                     {r.dx, r.dy, r.dz},
-                                     t_base,
-                                     dt,
-                                     {g.hi_x, g.hi_y, g.hi_z},
-                                     {g.cell_x, g.cell_y, g.cell_z},
-                                     int32_t(g.sy),
-                                     int32_t(g.sz),
-                                     map.offset(),
-                                     map.scale(),
-                                     float(map.last())};
-        }
-#endif
     }
 
     // Queues the samples [kb, ke) (after every sample queued before); false once the ray is
@@ -188,24 +174,9 @@ private:
         return !opaque;
     }
 
-#if LACUNA_SIMD_SSE41
-    static constexpr bool kSimd = std::is_same_v<Index, int32_t> && kBatch == 8;
-    simd::Sample4Grid m_sg;
-#else
-    static constexpr bool kSimd = false;
-#endif
 
     // LUT entries of the kBatch queued samples.
     LACUNA_ALWAYS_INLINE void lut_entries(int* entry) const {
-#if LACUNA_SIMD_SSE41
-        if constexpr (kSimd) {
-            // The whole sample in registers, four lanes at a time (core/simd.h).
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(entry), simd::sample4(m_sg, m_g.data, m_k));
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(entry + 4),
-                             simd::sample4(m_sg, m_g.data, m_k + 4));
-            return;
-        }
-#endif
         const Grid<T, Index>& g = m_g;
         const IndexRay& r = m_r;
         float fx[kBatch], fy[kBatch], fz[kBatch];
