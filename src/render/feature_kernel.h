@@ -286,15 +286,16 @@ inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g,
 
 // ---- The batched composite ray (the SIMD paths; composite_ray above is the reference) --------
 //
-// composite_ray's samples in two queues. Lattice samples are queued kShadeBatch at a time across
-// the cursor's runs (as kernel::RayStream queues them); a full queue gets its positions and
-// trilinear values in SIMD lanes, then, per sample in k order, the clip test, the side, the TF
-// entry and - for a sample with non-zero opacity - the opacity chain w = 1 - A, A += w * a with
+// composite_ray's samples in two queues. Lattice samples are queued kLatticeBatch at a time
+// across the cursor's runs (as kernel::RayStream queues them); a full queue gets its positions,
+// trilinear values, LUT entries and TF-opacity mask in SIMD lanes, then, per sample in k order,
+// the clip test and the side (when there are any) and - for a sample with non-zero opacity - the
+// opacity chain w = 1 - A, A += w * a with
 // early termination. Opacity does not depend on the gradient (gradient opacity stays on
 // composite_ray), so the chain finds the terminating sample before any gradient is taken, and
 // the visible samples up to it go to the second queue with their w and a. A full visible queue
-// (or the ray's end) gets its gradients in SIMD lanes, then shading and the colour chains
-// C += w * rgb * a in k order.
+// (or the ray's end) gets its gradients in SIMD lanes, then shading (in lanes on AVX2 for head
+// and directional lights) and the colour chains C += w * rgb * a in k order.
 //
 // Every quantity is the one composite_ray computes for the same sample with the same operations
 // (core/simd_shading.h for the lanes; for head and directional lights the half vector once per
@@ -307,9 +308,10 @@ inline constexpr int kShadeBatch = 8;
 // Lattice samples per evaluation: two lane batches, whose loads overlap.
 inline constexpr int kLatticeBatch = 2 * kShadeBatch;
 
-// Lane operations of one ISA path over kShadeBatch positions: trilinear values, on-the-fly
-// gradients, gradient-volume lookups. W = 4: SSE4.1 (two calls), W = 8: AVX2 (also the path
-// for AVX-512 CPUs: a batch is 8 samples).
+// Lane operations of one ISA path over kShadeBatch positions: lattice samples (positions,
+// values, LUT entries, opacity mask), on-the-fly gradients, gradient-volume lookups, shading.
+// W = 4: SSE4.1 (two calls per batch; shading per sample), W = 8: AVX2 (also the path for
+// AVX-512 CPUs: a batch is 8 samples).
 template <int W>
 struct ShadeOps;
 #if LACUNA_SIMD_X86 && defined(__SSE4_1__)
@@ -320,7 +322,7 @@ struct ShadeOps<4> {
                       const float*, float*, float*, float*, int) {}
     static void pbr(const simd::PbrLanes&, const simd::ShadeLight&, const float*, const float*,
                     const float*, float*, float*, float*) {}
-    // Gradients of the first n positions (four at a time).
+    // The first n of 8 lattice samples (four at a time); returns the opacity mask.
     template <class T>
     static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
                             const int32_t* k, float* x, float* y, float* z, float* v,
@@ -329,6 +331,7 @@ struct ShadeOps<4> {
         if (n > 4) mask |= unsigned(simd::samples4(g, r, d, k + 4, x + 4, y + 4, z + 4, v + 4, e + 4)) << 4;
         return mask;
     }
+    // Gradients of the first n positions (four at a time).
     template <class T>
     static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
                           const float* z, float* gx, float* gy, float* gz, int n) {
