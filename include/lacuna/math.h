@@ -1,5 +1,5 @@
 // Small fixed-size vector types used across the public API. Plain aggregates, no SIMD
-// (the SIMD helpers live in src/core/simd.h).
+// (the SIMD kernels live in src/core/simd_lanes.h).
 #pragma once
 #include <algorithm>
 #include <cmath>

@@ -71,6 +71,19 @@ struct LaneGrid {
     float ert;
 };
 
+// Eight camera rays at once, for the scheduler's ray set-up: Camera::generate, the move into
+// index space and kernel::intersect_box, each lane with exactly their scalar operations (same
+// order, IEEE div and sqrt, min/max with std::min/std::max's tie rule).
+struct CameraView {
+    float eye[3], forward[3], right[3], up[3];
+    float half_h, width, height;
+    bool ortho;
+};
+struct RayBatch8 {
+    alignas(32) float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8], t_near[8], t_far[8];
+    alignas(32) int32_t hit[8];  // -1: the ray meets the box [0, hi]
+};
+
 #if LACUNA_SIMD_X86
 
 // ---- SSE4.1: four lanes (the baseline) -------------------------------------------------------
@@ -573,6 +586,64 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         }
     }
 #undef LACUNA_LOAD_LANES
+}
+
+// ---- Ray set-up, eight pixels (AVX2) ------------------------------------------------------------
+LACUNA_AVX2 inline void setup_rays8(const CameraView& c, const float* px, const float* py,
+                                    const float inv_sp[3], const float hi[3], RayBatch8& out) {
+    const __m256 one = _mm256_set1_ps(1.f), two = _mm256_set1_ps(2.f), half = _mm256_set1_ps(0.5f);
+    const __m256 w = _mm256_set1_ps(c.width), h = _mm256_set1_ps(c.height);
+    const __m256 aspect = _mm256_set1_ps(c.width / c.height), hh = _mm256_set1_ps(c.half_h);
+    // sx = (2 * (px + 0.5) / W - 1) * aspect * half_h;  sy = (1 - 2 * (py + 0.5) / H) * half_h
+    const __m256 sx = _mm256_mul_ps(
+        _mm256_mul_ps(_mm256_sub_ps(_mm256_div_ps(_mm256_mul_ps(two, _mm256_add_ps(_mm256_loadu_ps(px), half)), w), one),
+                      aspect),
+        hh);
+    const __m256 sy = _mm256_mul_ps(
+        _mm256_sub_ps(one, _mm256_div_ps(_mm256_mul_ps(two, _mm256_add_ps(_mm256_loadu_ps(py), half)), h)), hh);
+    __m256 o[3], d[3];
+    for (int a = 0; a < 3; ++a) {
+        const __m256 r = _mm256_set1_ps(c.right[a]), u = _mm256_set1_ps(c.up[a]);
+        if (c.ortho) {
+            o[a] = _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(c.eye[a]), _mm256_mul_ps(r, sx)),
+                                 _mm256_mul_ps(u, sy));
+            d[a] = _mm256_set1_ps(c.forward[a]);
+        } else {
+            o[a] = _mm256_set1_ps(c.eye[a]);
+            d[a] = _mm256_add_ps(_mm256_add_ps(_mm256_set1_ps(c.forward[a]), _mm256_mul_ps(r, sx)),
+                                 _mm256_mul_ps(u, sy));
+        }
+    }
+    if (!c.ortho) {  // normalize: v / sqrt(x*x + y*y + z*z)
+        const __m256 len = _mm256_sqrt_ps(_mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])), _mm256_mul_ps(d[2], d[2])));
+        for (int a = 0; a < 3; ++a) d[a] = _mm256_div_ps(d[a], len);
+    }
+    __m256 t0 = _mm256_setzero_ps(), t1 = _mm256_set1_ps(__builtin_inff());
+    __m256 miss = _mm256_setzero_ps();
+    for (int a = 0; a < 3; ++a) {
+        o[a] = _mm256_mul_ps(o[a], _mm256_set1_ps(inv_sp[a]));
+        d[a] = _mm256_mul_ps(d[a], _mm256_set1_ps(inv_sp[a]));
+        const __m256 vhi = _mm256_set1_ps(hi[a]);
+        const __m256 flat = _mm256_cmp_ps(d[a], _mm256_setzero_ps(), _CMP_EQ_OQ);
+        // d == 0: a miss if the origin lies outside [0, hi] on this axis; no slab otherwise.
+        miss = _mm256_or_ps(miss, _mm256_and_ps(flat, _mm256_or_ps(
+                                                        _mm256_cmp_ps(o[a], _mm256_setzero_ps(), _CMP_LT_OQ),
+                                                        _mm256_cmp_ps(o[a], vhi, _CMP_GT_OQ))));
+        const __m256 inv = _mm256_div_ps(one, d[a]);
+        const __m256 ta = _mm256_mul_ps(_mm256_sub_ps(_mm256_setzero_ps(), o[a]), inv);
+        const __m256 tb = _mm256_mul_ps(_mm256_sub_ps(vhi, o[a]), inv);
+        const __m256 sw = _mm256_cmp_ps(ta, tb, _CMP_GT_OQ);
+        const __m256 lo = _mm256_blendv_ps(ta, tb, sw), up = _mm256_blendv_ps(tb, ta, sw);
+        // t0 = std::max(t0, lo) = t0 < lo ? lo : t0;  t1 = std::min(t1, up) = up < t1 ? up : t1
+        t0 = _mm256_blendv_ps(t0, _mm256_blendv_ps(t0, lo, _mm256_cmp_ps(t0, lo, _CMP_LT_OQ)), _mm256_xor_ps(flat, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+        t1 = _mm256_blendv_ps(t1, _mm256_blendv_ps(t1, up, _mm256_cmp_ps(up, t1, _CMP_LT_OQ)), _mm256_xor_ps(flat, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+    }
+    const __m256 hit = _mm256_andnot_ps(miss, _mm256_cmp_ps(t0, t1, _CMP_LT_OQ));
+    _mm256_store_ps(out.ox, o[0]), _mm256_store_ps(out.oy, o[1]), _mm256_store_ps(out.oz, o[2]);
+    _mm256_store_ps(out.dx, d[0]), _mm256_store_ps(out.dy, d[1]), _mm256_store_ps(out.dz, d[2]);
+    _mm256_store_ps(out.t_near, t0), _mm256_store_ps(out.t_far, t1);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(out.hit), _mm256_castps_si256(hit));
 }
 
 #endif  // LACUNA_SIMD_X86

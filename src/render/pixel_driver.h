@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "accel/cursor.h"
+#include "core/simd_lanes.h"
 #include "lacuna/camera.h"
 #include "lacuna/renderer.h"
 #include "lacuna/volume.h"
@@ -32,6 +33,14 @@ inline float sample_distance(const Volume& vol, float step) {
 inline kernel::IndexRay index_ray(const Ray& wr, Vec3f inv_sp) {
     const Vec3f o = wr.origin * inv_sp, dir = wr.dir * inv_sp;
     return kernel::IndexRay{o.x, o.y, o.z, dir.x, dir.y, dir.z};
+}
+
+// The camera as the batched ray set-up reads it (core/simd_lanes.h setup_rays8).
+inline simd::CameraView camera_view(const Camera& c) {
+    const Vec3f e = c.eye(), f = c.forward(), r = c.right(), u = c.up();
+    return simd::CameraView{{e.x, e.y, e.z}, {f.x, f.y, f.z}, {r.x, r.y, r.z}, {u.x, u.y, u.z},
+                            c.half_height(), float(c.width()), float(c.height()),
+                            c.projection() == Projection::Orthographic};
 }
 
 inline CursorRay cursor_ray(const kernel::IndexRay& r) {

@@ -175,16 +175,41 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
     }
     int next_pixel = 0, live = 0;
     uint64_t tile_samples = 0, tile_rays = 0;
+    // Rays are set up eight at a time (AVX2, on the 8- and 16-lane paths) in pixel order.
+    constexpr bool kBatchSetup = W >= 8;
+    const simd::CameraView cv = camera_view(cam);
+    const float isp[3] = {inv_sp.x, inv_sp.y, inv_sp.z};
+    simd::RayBatch8 rb;
+    int rb_base = -8;
+    auto ray_of = [&](int q, kernel::IndexRay& r, float& t_near, float& t_far) {
+        if constexpr (kBatchSetup) {
+            if (q >= rb_base + 8) {
+                rb_base = q;
+                alignas(32) float px[8], py[8];
+                for (int i = 0; i < 8; ++i) {
+                    const int j = std::min(q + i, npix - 1);
+                    px[i] = float(order[j][0]), py[i] = float(order[j][1]);
+                }
+                simd::setup_rays8(cv, px, py, isp, hi, rb);
+            }
+            const int i = q - rb_base;
+            r = {rb.ox[i], rb.oy[i], rb.oz[i], rb.dx[i], rb.dy[i], rb.dz[i]};
+            t_near = rb.t_near[i], t_far = rb.t_far[i];
+            return rb.hit[i] != 0;
+        } else {
+            r = index_ray(cam.generate(float(order[q][0]), float(order[q][1])), inv_sp);
+            return kernel::intersect_box(r, hi, t_near, t_far);
+        }
+    };
     // Puts the tile's next ray with at least one run into lane l (pixels without one are written
     // on the way); idles the lane when the tile has no rays left.
     auto start = [&](int l) {
         while (next_pixel < npix) {
             const int x = order[next_pixel][0], y = order[next_pixel][1];
-            ++next_pixel;
-            const kernel::IndexRay r = index_ray(cam.generate(float(x), float(y)), inv_sp);
+            kernel::IndexRay r;
             float t_near, t_far;
             int kb, ke;
-            if (kernel::intersect_box(r, hi, t_near, t_far)) {
+            if (ray_of(next_pixel++, r, t_near, t_far)) {
                 ++tile_rays;
                 Slot& sl = slot[l];
                 sl.runs.reset();
