@@ -12,9 +12,8 @@ void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
         // std::lround for x in [0, 255] without the libm call: x - trunc(x) is exact there,
         // so the half-away-from-zero test is exact too.
         const float x = std::clamp(rgb[c], 0.f, 1.f) * 255.f;
-        int v = int(x);
-        if (x - float(v) >= 0.5f) ++v;
-        px[c] = uint8_t(v);
+        const int v = int(x);
+        px[c] = uint8_t(v + int(x - float(v) >= 0.5f));
     }
     px[3] = 255;
     const size_t p = size_t(y) * size_t(out.image.width) + size_t(x);
