@@ -4,8 +4,10 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "common/rng.h"
+#include "core/simd_lanes.h"
 #include "lacuna/camera.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
@@ -78,5 +80,26 @@ inline Volume random_volume(Rng& rng, int max_dim) {
     v.compute_range();
     return v;
 }
+
+// A dense LUT of `entries` entries, every one different (a third transparent): an interpolated
+// value one ulp off usually lands in another entry, so a kernel path that rounds differently
+// shows in the image.
+inline void make_dense(TransferLut& lut, size_t entries, Rng& rng) {
+    lut.entries.resize(entries);
+    for (Rgba& e : lut.entries)
+        e = {rng.uniform(), rng.uniform(), rng.uniform(), rng.coin(3) ? 0.f : rng.uniform()};
+}
+
+// Every kernel path this CPU runs (core/simd_lanes.h), narrowest (scalar) first; the active path
+// is restored when this goes out of scope.
+struct KernelPaths {
+    std::vector<simd::Isa> paths;
+    simd::Isa saved = simd::active_isa();
+    KernelPaths() {
+        for (simd::Isa i : {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
+            if (simd::isa_supported(i)) paths.push_back(i);
+    }
+    ~KernelPaths() { simd::set_isa(saved); }
+};
 
 }  // namespace lacuna::test

@@ -222,13 +222,8 @@ TEST(FeatureConformance, EveryOptionIsExactForEveryStructure) {
 // termination. Half the trials use a dense LUT (every entry different, so a value one ulp off
 // lands in another entry and shows).
 TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
-    struct Restore {
-        simd::Isa isa = simd::active_isa();
-        ~Restore() { simd::set_isa(isa); }
-    } restore;
-    std::vector<simd::Isa> paths;
-    for (simd::Isa i : {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
-        if (simd::isa_supported(i)) paths.push_back(i);
+    const test::KernelPaths kp;
+    const std::vector<simd::Isa>& paths = kp.paths;
     ASSERT_GE(paths.size(), 2u) << "at least the scalar path and one SIMD path";
     Rng rng{2031};
     int compared = 0;
@@ -236,11 +231,7 @@ TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
         for (int trial = 0; trial < 3; ++trial) {
             const Volume v = test::random_volume(rng, 26);
             TransferLut front = test::random_lut(v.vis_range(), rng);
-            if (trial == 1) {
-                front.entries.resize(size_t(1) << 16);
-                for (Rgba& e : front.entries)
-                    e = {rng.uniform(), rng.uniform(), rng.uniform(), rng.coin(3) ? 0.f : rng.uniform()};
-            }
+            if (trial == 1) test::make_dense(front, size_t(1) << 16, rng);
             const TransferLut back_lut = test::random_lut(v.vis_range(), rng);
             const TransferLut* back = fc.two_tfs && trial != 1 ? &back_lut : nullptr;
             RenderOptions o;

@@ -210,26 +210,15 @@ TEST(Conformance, StructuresSkipSamplesOnSparseVolumes) {
 // bytes and float accumulations of the scalar --accel none render, for every structure, with and
 // without early termination, on every voxel type.
 TEST(Conformance, EveryKernelPathIsExactForEveryStructure) {
-    struct Restore {
-        simd::Isa isa = simd::active_isa();
-        ~Restore() { simd::set_isa(isa); }
-    } restore;
-    std::vector<simd::Isa> paths;
-    for (simd::Isa i : {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
-        if (simd::isa_supported(i)) paths.push_back(i);
+    const test::KernelPaths kp;
+    const std::vector<simd::Isa>& paths = kp.paths;
     ASSERT_GE(paths.size(), 2u) << "at least the scalar path and one SIMD path";
     Rng rng{2026};
     int compared = 0;
     for (int trial = 0; trial < 16; ++trial) {
         const Volume v = test::random_volume(rng, 33);
         TransferLut lut = random_lut(v.vis_range(), rng);
-        if (trial % 4 >= 2) {
-            // A dense LUT (2^18 entries, every one different): an interpolated value one ulp
-            // off usually lands in another entry, so a path that rounds differently shows.
-            lut.entries.resize(size_t(1) << 18);
-            for (Rgba& e : lut.entries)
-                e = {rng.uniform(), rng.uniform(), rng.uniform(), rng.coin(3) ? 0.f : rng.uniform()};
-        }
+        if (trial % 4 >= 2) test::make_dense(lut, size_t(1) << 18, rng);
         RenderOptions o;
         o.keep_float = true;
         o.count_samples = true;
