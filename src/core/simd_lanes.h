@@ -255,16 +255,112 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
 // ---- AVX2: eight lanes ---------------------------------------------------------------------
 #define LACUNA_AVX2 __attribute__((target("avx2")))
 
+// Trilinear values at eight index-space points (clamped into [0, hi] first, as trilinear()
+// does), trilinear()'s operations in its order. G has hi[3], cell[3], sy, sz. Corners: uint8
+// pairs by 16-bit scalar loads (cheaper than gathers here), wider types by 32-bit gathers.
+template <class T, class G>
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
+                                                                    const T* data, __m256 x,
+                                                                    __m256 y, __m256 z) {
+    const __m256 zero = _mm256_setzero_ps();
+    x = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), x));
+    y = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), y));
+    z = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), z));
+    const __m256i ci = _mm256_min_epi32(_mm256_cvttps_epi32(x), _mm256_set1_epi32(g.cell[0]));
+    const __m256i cj = _mm256_min_epi32(_mm256_cvttps_epi32(y), _mm256_set1_epi32(g.cell[1]));
+    const __m256i ck = _mm256_min_epi32(_mm256_cvttps_epi32(z), _mm256_set1_epi32(g.cell[2]));
+    const __m256 fx = _mm256_sub_ps(x, _mm256_cvtepi32_ps(ci));
+    const __m256 fy = _mm256_sub_ps(y, _mm256_cvtepi32_ps(cj));
+    const __m256 fz = _mm256_sub_ps(z, _mm256_cvtepi32_ps(ck));
+    const __m256i off = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                         _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+        ci);
+    constexpr bool kByte = sizeof(T) == 1;
+    const __m256i o1 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy - 2 : g.sy));
+    const __m256i o2 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sz - 2 : g.sz));
+    const __m256i o3 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz));
+    __m256 c000, c100, c010, c110, c001, c101, c011, c111;
+    if constexpr (kByte) {
+        // Corner pairs by 16-bit scalar loads into a small table (cheaper than four gathers
+        // here), then widened: low byte voxel i, high byte voxel i + 1.
+        alignas(32) int32_t o[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(o), off);
+        alignas(16) uint16_t w[4][8];
+        const ptrdiff_t sy = g.sy, sz = g.sz, syz = sy + sz;
+        for (int l = 0; l < 8; ++l) {
+            const T* p = data + o[l];
+            __builtin_memcpy(&w[0][l], p, 2);
+            __builtin_memcpy(&w[1][l], p + sy, 2);
+            __builtin_memcpy(&w[2][l], p + sz, 2);
+            __builtin_memcpy(&w[3][l], p + syz, 2);
+        }
+        const __m256i m = _mm256_set1_epi32(0xff);
+        const __m256i w0 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[0])));
+        const __m256i w1 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[1])));
+        const __m256i w2 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[2])));
+        const __m256i w3 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[3])));
+        c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
+        c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 8));
+        c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
+        c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 8));
+        c001 = _mm256_cvtepi32_ps(_mm256_and_si256(w2, m));
+        c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 8));
+        c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
+        c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 8));
+    } else if constexpr (sizeof(T) == 2) {
+        const int* base = reinterpret_cast<const int*>(data);
+        const __m256i w0 = _mm256_i32gather_epi32(base, off, 2);
+        const __m256i w1 = _mm256_i32gather_epi32(base, o1, 2);
+        const __m256i w2 = _mm256_i32gather_epi32(base, o2, 2);
+        const __m256i w3 = _mm256_i32gather_epi32(base, o3, 2);
+        if constexpr (std::is_signed_v<T>) {
+            c000 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w0, 16), 16));
+            c010 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w1, 16), 16));
+            c001 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w2, 16), 16));
+            c011 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w3, 16), 16));
+            c100 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w0, 16));
+            c110 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w1, 16));
+            c101 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w2, 16));
+            c111 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w3, 16));
+        } else {
+            const __m256i m = _mm256_set1_epi32(0xffff);
+            c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
+            c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
+            c001 = _mm256_cvtepi32_ps(_mm256_and_si256(w2, m));
+            c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
+            c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 16));
+            c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 16));
+            c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 16));
+            c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 16));
+        }
+    } else {
+        static_assert(std::is_same_v<T, float>, "voxel types: uint8, int16, uint16, float");
+        const float* base = data;
+        c000 = _mm256_i32gather_ps(base, off, 4);
+        c100 = _mm256_i32gather_ps(base + 1, off, 4);
+        c010 = _mm256_i32gather_ps(base, o1, 4);
+        c110 = _mm256_i32gather_ps(base + 1, o1, 4);
+        c001 = _mm256_i32gather_ps(base, o2, 4);
+        c101 = _mm256_i32gather_ps(base + 1, o2, 4);
+        c011 = _mm256_i32gather_ps(base, o3, 4);
+        c111 = _mm256_i32gather_ps(base + 1, o3, 4);
+    }
+    const __m256 c00 = _mm256_add_ps(c000, _mm256_mul_ps(fx, _mm256_sub_ps(c100, c000)));
+    const __m256 c10 = _mm256_add_ps(c010, _mm256_mul_ps(fx, _mm256_sub_ps(c110, c010)));
+    const __m256 c01 = _mm256_add_ps(c001, _mm256_mul_ps(fx, _mm256_sub_ps(c101, c001)));
+    const __m256 c11 = _mm256_add_ps(c011, _mm256_mul_ps(fx, _mm256_sub_ps(c111, c011)));
+    const __m256 c0 = _mm256_add_ps(c00, _mm256_mul_ps(fy, _mm256_sub_ps(c10, c00)));
+    const __m256 c1 = _mm256_add_ps(c01, _mm256_mul_ps(fy, _mm256_sub_ps(c11, c01)));
+    return _mm256_add_ps(c0, _mm256_mul_ps(fz, _mm256_sub_ps(c1, c0)));
+}
+
+
 template <class T, class Refill>
 LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                               Refill& refill) {
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.f);
     const __m256 vdt = _mm256_set1_ps(g.dt), vert = _mm256_set1_ps(g.ert);
-    const __m256 vhi0 = _mm256_set1_ps(g.hi[0]), vhi1 = _mm256_set1_ps(g.hi[1]),
-                 vhi2 = _mm256_set1_ps(g.hi[2]);
-    const __m256i vc0 = _mm256_set1_epi32(g.cell[0]), vc1 = _mm256_set1_epi32(g.cell[1]),
-                  vc2 = _mm256_set1_epi32(g.cell[2]);
-    const __m256i vsy = _mm256_set1_epi32(g.sy), vsz = _mm256_set1_epi32(g.sz);
     const __m256 voff = _mm256_set1_ps(g.lut_offset), vscale = _mm256_set1_ps(g.lut_scale),
                  vlast = _mm256_set1_ps(g.lut_last);
     const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
@@ -283,13 +379,6 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));
     int active_mask, waiting = 0;
     LACUNA_LOAD_LANES
-    // Gather offsets of the corner pairs (in elements): 0, sy, sz, sy + sz. For uint8 a 32-bit
-    // gather reads 4 bytes; the pairs past the first are read from 2 bytes before them (bytes 2
-    // and 3 of the word) so no read passes the last voxel, and the first from its own offset.
-    constexpr bool kByte = sizeof(T) == 1;
-    const __m256i q1 = _mm256_set1_epi32(kByte ? g.sy - 2 : g.sy);
-    const __m256i q2 = _mm256_set1_epi32(kByte ? g.sz - 2 : g.sz);
-    const __m256i q3 = _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz);
     int need;
     for (;;) {
         const __m256i valid = _mm256_cmpgt_epi32(kend, k);
@@ -298,81 +387,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
         __m256 x = _mm256_add_ps(ox, _mm256_mul_ps(t, dx));
         __m256 y = _mm256_add_ps(oy, _mm256_mul_ps(t, dy));
         __m256 z = _mm256_add_ps(oz, _mm256_mul_ps(t, dz));
-        x = _mm256_max_ps(zero, _mm256_min_ps(vhi0, x));
-        y = _mm256_max_ps(zero, _mm256_min_ps(vhi1, y));
-        z = _mm256_max_ps(zero, _mm256_min_ps(vhi2, z));
-        const __m256i ci = _mm256_min_epi32(_mm256_cvttps_epi32(x), vc0);
-        const __m256i cj = _mm256_min_epi32(_mm256_cvttps_epi32(y), vc1);
-        const __m256i ck = _mm256_min_epi32(_mm256_cvttps_epi32(z), vc2);
-        const __m256 fx = _mm256_sub_ps(x, _mm256_cvtepi32_ps(ci));
-        const __m256 fy = _mm256_sub_ps(y, _mm256_cvtepi32_ps(cj));
-        const __m256 fz = _mm256_sub_ps(z, _mm256_cvtepi32_ps(ck));
-        __m256i off = _mm256_add_epi32(
-            _mm256_add_epi32(_mm256_mullo_epi32(ck, vsz), _mm256_mullo_epi32(cj, vsy)), ci);
-        off = _mm256_and_si256(off, active);  // idle lanes read voxel 0
-        __m256 c000, c100, c010, c110, c001, c101, c011, c111;
-        if constexpr (kByte) {
-            const int* base = reinterpret_cast<const int*>(data);
-            const __m256i w0 = _mm256_i32gather_epi32(base, off, 1);
-            const __m256i w1 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q1), 1);
-            const __m256i w2 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q2), 1);
-            const __m256i w3 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q3), 1);
-            const __m256i m = _mm256_set1_epi32(0xff);
-            c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
-            c100 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w0, 8), m));
-            c010 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w1, 16), m));
-            c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 24));
-            c001 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w2, 16), m));
-            c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 24));
-            c011 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w3, 16), m));
-            c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 24));
-        } else if constexpr (sizeof(T) == 2) {
-            const int* base = reinterpret_cast<const int*>(data);
-            const __m256i w0 = _mm256_i32gather_epi32(base, off, 2);
-            const __m256i w1 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q1), 2);
-            const __m256i w2 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q2), 2);
-            const __m256i w3 = _mm256_i32gather_epi32(base, _mm256_add_epi32(off, q3), 2);
-            if constexpr (std::is_signed_v<T>) {
-                c000 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w0, 16), 16));
-                c010 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w1, 16), 16));
-                c001 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w2, 16), 16));
-                c011 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w3, 16), 16));
-                c100 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w0, 16));
-                c110 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w1, 16));
-                c101 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w2, 16));
-                c111 = _mm256_cvtepi32_ps(_mm256_srai_epi32(w3, 16));
-            } else {
-                const __m256i m = _mm256_set1_epi32(0xffff);
-                c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
-                c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
-                c001 = _mm256_cvtepi32_ps(_mm256_and_si256(w2, m));
-                c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
-                c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 16));
-                c110 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w1, 16));
-                c101 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w2, 16));
-                c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 16));
-            }
-        } else {
-            const float* base = reinterpret_cast<const float*>(data);
-            const __m256i o1 = _mm256_add_epi32(off, q1), o2 = _mm256_add_epi32(off, q2),
-                          o3 = _mm256_add_epi32(off, q3);
-            c000 = _mm256_i32gather_ps(base, off, 4);
-            c100 = _mm256_i32gather_ps(base + 1, off, 4);
-            c010 = _mm256_i32gather_ps(base, o1, 4);
-            c110 = _mm256_i32gather_ps(base + 1, o1, 4);
-            c001 = _mm256_i32gather_ps(base, o2, 4);
-            c101 = _mm256_i32gather_ps(base + 1, o2, 4);
-            c011 = _mm256_i32gather_ps(base, o3, 4);
-            c111 = _mm256_i32gather_ps(base + 1, o3, 4);
-        }
-        // Trilinear lerps a + w * (b - a), in trilinear()'s order; then ValueToLut.
-        const __m256 c00 = _mm256_add_ps(c000, _mm256_mul_ps(fx, _mm256_sub_ps(c100, c000)));
-        const __m256 c10 = _mm256_add_ps(c010, _mm256_mul_ps(fx, _mm256_sub_ps(c110, c010)));
-        const __m256 c01 = _mm256_add_ps(c001, _mm256_mul_ps(fx, _mm256_sub_ps(c101, c001)));
-        const __m256 c11 = _mm256_add_ps(c011, _mm256_mul_ps(fx, _mm256_sub_ps(c111, c011)));
-        const __m256 c0 = _mm256_add_ps(c00, _mm256_mul_ps(fy, _mm256_sub_ps(c10, c00)));
-        const __m256 c1 = _mm256_add_ps(c01, _mm256_mul_ps(fy, _mm256_sub_ps(c11, c01)));
-        const __m256 v = _mm256_add_ps(c0, _mm256_mul_ps(fz, _mm256_sub_ps(c1, c0)));
+        const __m256 v = trilinear8(g, data, x, y, z);
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
         const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), valid);
@@ -423,6 +438,11 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
 }
 
 // ---- AVX-512: sixteen lanes ------------------------------------------------------------------
+// GCC 12's avx512fintrin.h seeds unmasked intrinsics with _mm512_undefined_ps(), which
+// -Wuninitialized reports inside target("avx512f") functions: a false positive.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define LACUNA_AVX512 __attribute__((target("avx512f")))
 
 template <class T, class Refill>
@@ -587,6 +607,8 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     }
 #undef LACUNA_LOAD_LANES
 }
+
+#pragma GCC diagnostic pop
 
 // ---- Ray set-up, eight pixels (AVX2) ------------------------------------------------------------
 LACUNA_AVX2 inline void setup_rays8(const CameraView& c, const float* px, const float* py,
