@@ -140,7 +140,7 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
     const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, opt.step);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
-    const float chunk = opt.ert < 1.f ? kCursorChunk * dt : 0.f;
+    const float chunk = opt.ert < 1.f ? kLaneChunk * dt : 0.f;
     const simd::LaneGrid lg{dt,
                             {g.hi_x, g.hi_y, g.hi_z},
                             {g.cell_x, g.cell_y, g.cell_z},
