@@ -278,6 +278,46 @@ void check_skipped_samples(const BrickGrid& g, const Volume& v, const T* data,
     }
 }
 
+// The renderer's walk (brick_run: registers, branch-free axis choice) hands out exactly the
+// stretches of the reference walk through step(), on every kind of ray and every setting of the
+// stretch bookkeeping (minimum skip, chunks).
+TEST(BrickGrid, FastWalkGivesTheStepWalksStretchesToTheBit) {
+    Rng rng{9106};
+    int segments = 0;
+    for (int trial = 0; trial < 30; ++trial) {
+        const Volume v = trial % 2 ? sparse_volume(kAllTypes[trial % 4], random_dims(rng, 6, 90), rng)
+                                   : random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 2);
+        BrickGrid g(v, o);
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        g.set_transfer_function(
+            random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng, 3)));
+        const Vec3i d = v.dims();
+        const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
+        for (int ray = 0; ray < 60; ++ray) {
+            kernel::IndexRay r;
+            float t_near, t_far;
+            if (!corner_ray(hi, 1 << g.brick_log2(), rng, r, t_near, t_far)) continue;
+            const float dt = 0.05f + 0.5f * rng.uniform();
+            const float min_skip = rng.coin() ? 0.f : dt, chunk = rng.coin() ? 0.f : 16.f * dt;
+            BrickGrid::Cursor fast(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
+            BrickGrid::Cursor slow(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
+            Segment a, b;
+            for (int n = 0;; ++n) {
+                ASSERT_LT(n, 100000);
+                const bool ga = fast.next<true>(a), gb = slow.next<false>(b);
+                ASSERT_EQ(ga, gb) << "ray " << ray << " segment " << n;
+                if (!ga) break;
+                ASSERT_EQ(a.t0, b.t0) << "ray " << ray << " segment " << n;
+                ASSERT_EQ(a.t1, b.t1) << "ray " << ray << " segment " << n;
+                ++segments;
+            }
+        }
+    }
+    EXPECT_GT(segments, 500);
+}
+
 TEST(BrickGrid, CursorSkipsOnlyInvisibleSamplesOnRaysThroughBrickCornersAndEdges) {
     Rng rng{9103};
     int skipped = 0, kept = 0;
