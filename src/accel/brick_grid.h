@@ -97,7 +97,10 @@ private:
 };
 
 // Front-to-back walk of one ray through the grid; hands out the stretches that may hold visible
-// samples (the RegionCursor interface). Empty blocks are crossed in one step.
+// samples (the RegionCursor interface). step() is the walk as the exactness argument states it
+// (and as the tests inspect it); next() takes its brick steps through brick_run(), the same walk
+// with the state in registers, tested to hand out the same stretches to the bit. Empty blocks
+// are left in one leap.
 class BrickGrid::Cursor {
 public:
     // min_skip: empty stretches not longer than this stay in the run (world units). chunk: an
