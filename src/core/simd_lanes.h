@@ -309,11 +309,22 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
         c011 = _mm256_cvtepi32_ps(_mm256_and_si256(w3, m));
         c111 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w3, 8));
     } else if constexpr (sizeof(T) == 2) {
-        const int* base = reinterpret_cast<const int*>(data);
-        const __m256i w0 = _mm256_i32gather_epi32(base, off, 2);
-        const __m256i w1 = _mm256_i32gather_epi32(base, o1, 2);
-        const __m256i w2 = _mm256_i32gather_epi32(base, o2, 2);
-        const __m256i w3 = _mm256_i32gather_epi32(base, o3, 2);
+        // 16-bit voxels: each corner pair is one 32-bit scalar load, into a table.
+        alignas(32) int32_t o[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(o), off);
+        alignas(32) int32_t wq[4][8];
+        const ptrdiff_t sy = g.sy, sz = g.sz, syz = sy + sz;
+        for (int l = 0; l < 8; ++l) {
+            const T* p = data + o[l];
+            __builtin_memcpy(&wq[0][l], p, 4);
+            __builtin_memcpy(&wq[1][l], p + sy, 4);
+            __builtin_memcpy(&wq[2][l], p + sz, 4);
+            __builtin_memcpy(&wq[3][l], p + syz, 4);
+        }
+        const __m256i w0 = _mm256_load_si256(reinterpret_cast<const __m256i*>(wq[0]));
+        const __m256i w1 = _mm256_load_si256(reinterpret_cast<const __m256i*>(wq[1]));
+        const __m256i w2 = _mm256_load_si256(reinterpret_cast<const __m256i*>(wq[2]));
+        const __m256i w3 = _mm256_load_si256(reinterpret_cast<const __m256i*>(wq[3]));
         if constexpr (std::is_signed_v<T>) {
             c000 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w0, 16), 16));
             c010 = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w1, 16), 16));
@@ -526,10 +537,20 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
             c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
             c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 8));
         } else if constexpr (sizeof(T) == 2) {
-            const __m512i w0 = _mm512_i32gather_epi32(off, data, 2);
-            const __m512i w1 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q1), data, 2);
-            const __m512i w2 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q2), data, 2);
-            const __m512i w3 = _mm512_i32gather_epi32(_mm512_add_epi32(off, q3), data, 2);
+            // 16-bit voxels: each corner pair is one 32-bit scalar load, into a table.
+            alignas(64) int32_t ofs[16];
+            alignas(64) int32_t wq[4][16];
+            _mm512_store_si512(ofs, off);
+            const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
+            for (int l = 0; l < 16; ++l) {
+                const T* p = data + ofs[l];
+                __builtin_memcpy(&wq[0][l], p, 4);
+                __builtin_memcpy(&wq[1][l], p + psy, 4);
+                __builtin_memcpy(&wq[2][l], p + psz, 4);
+                __builtin_memcpy(&wq[3][l], p + psyz, 4);
+            }
+            const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
+            const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
             if constexpr (std::is_signed_v<T>) {
                 c000 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w0, 16), 16));
                 c010 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w1, 16), 16));
