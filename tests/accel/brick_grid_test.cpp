@@ -4,12 +4,13 @@
 // visible cell or with a visible value. The skip check uses the marcher's own position
 // expression for every skipped sample, on rays aimed at brick corners and edges, where a float
 // walk and the exact ray order crossings differently.
+#include "accel/brick_grid.h"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
 
 #include "accel/accel_impl.h"
-#include "accel/brick_grid.h"
 #include "accel_test_util.h"
 #include "lacuna/renderer.h"
 #include "render/pixel_driver.h"
@@ -125,8 +126,9 @@ TEST(BrickGrid, BlockDistancesAreTheChebyshevDistanceToTheNearestOccupiedBlock) 
                         for (int b = 0; b < nw[1]; ++b)
                             for (int a = 0; a < nw[0]; ++a)
                                 if (g.word(4 * a, 4 * b, 4 * c))
-                                    want = std::min(want, std::max({std::abs(a - x), std::abs(b - y),
-                                                                    std::abs(c - z)}));
+                                    want =
+                                        std::min(want, std::max({std::abs(a - x), std::abs(b - y),
+                                                                 std::abs(c - z)}));
                     ASSERT_EQ(g.block_distance(4 * x, 4 * y, 4 * z), std::max(want, 1))
                         << "block " << x << "," << y << "," << z;
                 }
@@ -157,6 +159,23 @@ bool corner_ray(const float hi[3], int B, Rng& rng, kernel::IndexRay& r, float& 
     return kernel::intersect_box(r, hi, t_near, t_far);
 }
 
+// Trial `trial` of a walk test: a sparse or a random volume, a grid with a random brick edge and
+// a TF visible at `spikes` of the volume's voxel values; calls fn(volume, grid, hi).
+template <class Fn>
+void with_random_grid(int trial, int spikes, Rng& rng, Fn&& fn) {
+    const Volume v = trial % 2 ? sparse_volume(kAllTypes[trial % 4], random_dims(rng, 6, 90), rng)
+                               : random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
+    AccelOptions o;
+    o.leaf_cells = 2 << rng.range(0, 2);
+    BrickGrid g(v, o);
+    const ValueToLut m(v.vis_range(), kDefaultLutSize);
+    g.set_transfer_function(
+        random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng, spikes)));
+    const Vec3i d = v.dims();
+    const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
+    fn(v, g, hi);
+}
+
 // The lemma the exactness argument rests on: the walk's steps tile [t_near, t_far], and every
 // lattice sample in a step's stretch, placed by the marcher's arithmetic, lies within far less
 // than one voxel of that step's brick (or block), so its cell is in the brick's apron.
@@ -165,65 +184,60 @@ TEST(BrickGrid, WalkStepsTileTheRayAndHoldTheMarchersSamplePositions) {
     int samples = 0, coarse = 0, leaps = 0;
     float worst = 0.f;
     for (int trial = 0; trial < 30; ++trial) {
-        const Volume v = trial % 2 ? sparse_volume(kAllTypes[trial % 4], random_dims(rng, 6, 90), rng)
-                                   : random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
-        AccelOptions o;
-        o.leaf_cells = 2 << rng.range(0, 2);
-        BrickGrid g(v, o);
-        const ValueToLut m(v.vis_range(), kDefaultLutSize);
-        g.set_transfer_function(
-            random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng, 2)));
-        const Vec3i dims = v.dims();
-        const float hi[3] = {float(dims.x - 1), float(dims.y - 1), float(dims.z - 1)};
-        const int B = 1 << g.brick_log2();
-        for (int ray = 0; ray < 80; ++ray) {
-            kernel::IndexRay r;
-            float t_near, t_far;
-            if (!corner_ray(hi, B, rng, r, t_near, t_far)) continue;
-            const float dt = 0.02f + 0.5f * rng.uniform();
-            const int k_end = lattice_end(t_near, t_far, dt);
-            BrickGrid::Cursor cursor(g, cursor_ray(r), t_near, t_far);
-            BrickGrid::Cursor::Step st;
-            float t_prev = t_near;
-            int k = 0, steps = 0;
-            while (cursor.step(st)) {
-                ASSERT_LT(++steps, 100000) << "the walk does not terminate";
-                ASSERT_EQ(st.t0, t_prev) << "steps must tile the ray";
-                ASSERT_LE(st.t0, st.t1);
-                t_prev = st.t1;
-                coarse += st.coarse;
-                for (int a = 0; a < 3; ++a) {
-                    ASSERT_LE(0, st.lo[a]);
-                    ASSERT_LE(st.lo[a], st.hi[a]);
-                    ASSERT_LT(st.hi[a], g.bricks()[a]);
-                }
-                if (st.coarse)  // a leap crosses only empty bricks
-                    for (int z = st.lo[2]; z <= st.hi[2]; ++z)
-                        for (int y = st.lo[1]; y <= st.hi[1]; ++y)
-                            for (int x = st.lo[0]; x <= st.hi[0]; ++x)
-                                ASSERT_FALSE(g.occupied(x, y, z)) << "leap over a visible brick";
-                leaps += st.coarse && (st.hi[0] - st.lo[0] > 3 || st.hi[1] - st.lo[1] > 3 ||
-                                       st.hi[2] - st.lo[2] > 3);
-                for (; k < k_end; ++k) {
-                    const float t = t_near + (float(k) + 0.5f) * dt;
-                    if (t > st.t1) break;
-                    float p[3] = {r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz};
+        with_random_grid(trial, 2, rng, [&](const Volume&, const BrickGrid& g, const float* hi) {
+            const int B = 1 << g.brick_log2();
+            for (int ray = 0; ray < 80; ++ray) {
+                kernel::IndexRay r;
+                float t_near, t_far;
+                if (!corner_ray(hi, B, rng, r, t_near, t_far)) continue;
+                const float dt = 0.02f + 0.5f * rng.uniform();
+                const int k_end = lattice_end(t_near, t_far, dt);
+                BrickGrid::Cursor cursor(g, cursor_ray(r), t_near, t_far);
+                BrickGrid::Cursor::Step st;
+                float t_prev = t_near;
+                int k = 0, steps = 0;
+                while (cursor.step(st)) {
+                    ASSERT_LT(++steps, 100000) << "the walk does not terminate";
+                    ASSERT_EQ(st.t0, t_prev) << "steps must tile the ray";
+                    ASSERT_LE(st.t0, st.t1);
+                    t_prev = st.t1;
+                    coarse += st.coarse;
                     for (int a = 0; a < 3; ++a) {
-                        p[a] = p[a] < 0.f ? 0.f : (p[a] > hi[a] ? hi[a] : p[a]);
-                        const float lo = float(st.lo[a] * B);
-                        const float up = std::min(hi[a], float((st.hi[a] + 1) * B));
-                        const float out = std::max(lo - p[a], p[a] - up);
-                        worst = std::max(worst, out);
-                        ASSERT_LT(out, 1e-3f) << "sample " << k << " at t " << t << " is "
-                                              << out << " voxels outside its step's box on axis "
-                                              << a << (st.coarse ? " (block)" : " (brick)");
+                        ASSERT_LE(0, st.lo[a]);
+                        ASSERT_LE(st.lo[a], st.hi[a]);
+                        ASSERT_LT(st.hi[a], g.bricks()[a]);
                     }
-                    ++samples;
+                    if (st.coarse)  // a leap crosses only empty bricks
+                        for (int z = st.lo[2]; z <= st.hi[2]; ++z)
+                            for (int y = st.lo[1]; y <= st.hi[1]; ++y)
+                                for (int x = st.lo[0]; x <= st.hi[0]; ++x)
+                                    ASSERT_FALSE(g.occupied(x, y, z))
+                                        << "leap over a visible brick";
+                    leaps += st.coarse && (st.hi[0] - st.lo[0] > 3 || st.hi[1] - st.lo[1] > 3 ||
+                                           st.hi[2] - st.lo[2] > 3);
+                    for (; k < k_end; ++k) {
+                        const float t = t_near + (float(k) + 0.5f) * dt;
+                        if (t > st.t1) break;
+                        float p[3] = {r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz};
+                        for (int a = 0; a < 3; ++a) {
+                            p[a] = p[a] < 0.f ? 0.f : (p[a] > hi[a] ? hi[a] : p[a]);
+                            const float lo = float(st.lo[a] * B);
+                            const float up = std::min(hi[a], float((st.hi[a] + 1) * B));
+                            const float out = std::max(lo - p[a], p[a] - up);
+                            worst = std::max(worst, out);
+                            ASSERT_LT(out, 1e-3f)
+                                << "sample " << k << " at t " << t << " is " << out
+                                << " voxels outside its step's box on axis " << a
+                                << (st.coarse ? " (block)" : " (brick)");
+                        }
+                        ++samples;
+                    }
                 }
+                ASSERT_EQ(t_prev, t_far) << "the walk must end at t_far";
+                ASSERT_EQ(k, k_end) << "every lattice sample lies in a step";
             }
-            ASSERT_EQ(t_prev, t_far) << "the walk must end at t_far";
-            ASSERT_EQ(k, k_end) << "every lattice sample lies in a step";
-        }
+        });
+        if (HasFatalFailure()) return;
     }
     EXPECT_GT(samples, 50000);
     EXPECT_GT(coarse, 100) << "the cases must take coarse steps";
@@ -285,35 +299,28 @@ TEST(BrickGrid, FastWalkGivesTheStepWalksStretchesToTheBit) {
     Rng rng{9106};
     int segments = 0;
     for (int trial = 0; trial < 30; ++trial) {
-        const Volume v = trial % 2 ? sparse_volume(kAllTypes[trial % 4], random_dims(rng, 6, 90), rng)
-                                   : random_volume(kAllTypes[trial % 4], random_dims(rng, 6, 70), rng);
-        AccelOptions o;
-        o.leaf_cells = 2 << rng.range(0, 2);
-        BrickGrid g(v, o);
-        const ValueToLut m(v.vis_range(), kDefaultLutSize);
-        g.set_transfer_function(
-            random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng, 3)));
-        const Vec3i d = v.dims();
-        const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
-        for (int ray = 0; ray < 60; ++ray) {
-            kernel::IndexRay r;
-            float t_near, t_far;
-            if (!corner_ray(hi, 1 << g.brick_log2(), rng, r, t_near, t_far)) continue;
-            const float dt = 0.05f + 0.5f * rng.uniform();
-            const float min_skip = rng.coin() ? 0.f : dt, chunk = rng.coin() ? 0.f : 16.f * dt;
-            BrickGrid::Cursor fast(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
-            BrickGrid::Cursor slow(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
-            Segment a, b;
-            for (int n = 0;; ++n) {
-                ASSERT_LT(n, 100000);
-                const bool ga = fast.next<true>(a), gb = slow.next<false>(b);
-                ASSERT_EQ(ga, gb) << "ray " << ray << " segment " << n;
-                if (!ga) break;
-                ASSERT_EQ(a.t0, b.t0) << "ray " << ray << " segment " << n;
-                ASSERT_EQ(a.t1, b.t1) << "ray " << ray << " segment " << n;
-                ++segments;
+        with_random_grid(trial, 3, rng, [&](const Volume&, const BrickGrid& g, const float* hi) {
+            for (int ray = 0; ray < 60; ++ray) {
+                kernel::IndexRay r;
+                float t_near, t_far;
+                if (!corner_ray(hi, 1 << g.brick_log2(), rng, r, t_near, t_far)) continue;
+                const float dt = 0.05f + 0.5f * rng.uniform();
+                const float min_skip = rng.coin() ? 0.f : dt, chunk = rng.coin() ? 0.f : 16.f * dt;
+                BrickGrid::Cursor fast(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
+                BrickGrid::Cursor slow(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
+                Segment a, b;
+                for (int n = 0;; ++n) {
+                    ASSERT_LT(n, 100000);
+                    const bool ga = fast.next<true>(a), gb = slow.next<false>(b);
+                    ASSERT_EQ(ga, gb) << "ray " << ray << " segment " << n;
+                    if (!ga) break;
+                    ASSERT_EQ(a.t0, b.t0) << "ray " << ray << " segment " << n;
+                    ASSERT_EQ(a.t1, b.t1) << "ray " << ray << " segment " << n;
+                    ++segments;
+                }
             }
-        }
+        });
+        if (HasFatalFailure()) return;
     }
     EXPECT_GT(segments, 500);
 }
