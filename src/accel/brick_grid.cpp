@@ -102,7 +102,6 @@ void BrickGrid::brick_range(int x, int y, int z, int& lo, int& hi) const {
 void BrickGrid::set_transfer_function(const TransferLut& lut) {
     const auto t0 = std::chrono::steady_clock::now();
     if (needs_rebuild(lut)) build();
-    m_prefix.build(lut);
     // The prefix count as one lookup: a range [lo, hi] holds a visible entry iff the first
     // visible entry at or after lo is <= hi. (Empty bricks past the grid: lo = 1 > hi = 0.)
     const int size = lut.size();

@@ -8,8 +8,8 @@
 //
 // TF-independent part (built once per volume): per brick of B^3 cells (B = --leaf, 8) the
 // LUT-entry range of its cells *and a one-cell apron* around them (apron_brick_ranges). Per TF:
-// one bit per brick, visible(lo, hi) by the min-max octree's opacity prefix count, packed in
-// blocks of 4x4x4 bricks per uint64 (a zero word is an empty block: the DDA's coarse level, free),
+// one bit per brick, whether [lo, hi] holds a visible entry (the min-max octree's prefix-count
+// test, as one lookup: the first visible entry at or after lo is <= hi), packed in blocks of 4x4x4 bricks per uint64 (a zero word is an empty block: the DDA's coarse level, free),
 // and per block the Chebyshev distance (in blocks) to the nearest block with a visible brick: in
 // empty space the walk leaps out of the whole cube of empty blocks that distance guarantees
 // (Deakin & Knackstedt's distance maps, on the block grid: a few thousand entries, so the map is
@@ -92,7 +92,6 @@ private:
     std::vector<uint64_t> m_words;
     std::vector<uint16_t> m_block_lo, m_block_hi;  // per block: union of its bricks' ranges
     std::vector<uint8_t> m_dist;  // per block: Chebyshev distance to an occupied block, 1..255
-    OpacityPrefix m_prefix;
     std::vector<uint16_t> m_next_visible;  // per LUT entry: the first visible entry >= it
 };
 

@@ -137,7 +137,7 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
         off = _mm_and_si128(off, active);
         alignas(16) int32_t ofs[4];
         _mm_store_si128(reinterpret_cast<__m128i*>(ofs), off);
-        // 2. Corners as pairs (as sample4).
+        // 2. Corners as pairs: one 16-bit (uint8), 32-bit (16-bit) or 64-bit (float) load each.
         __m128 lo[4], hi[4];
         if constexpr (sizeof(T) == 1) {
             __m128i v01 = _mm_setzero_si128(), v23 = _mm_setzero_si128();
@@ -485,9 +485,9 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     int waiting = 0;
     LACUNA_LOAD_LANES
     constexpr bool kByte = sizeof(T) == 1;
-    const __m512i q1 = _mm512_set1_epi32(kByte ? g.sy - 2 : g.sy);
-    const __m512i q2 = _mm512_set1_epi32(kByte ? g.sz - 2 : g.sz);
-    const __m512i q3 = _mm512_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz);
+    // Offsets of the corner pairs past the first (float voxels gather them).
+    const __m512i q1 = _mm512_set1_epi32(g.sy), q2 = _mm512_set1_epi32(g.sz),
+                  q3 = _mm512_set1_epi32(g.sy + g.sz);
     int need;
     for (;;) {
         const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);

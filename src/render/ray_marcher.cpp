@@ -126,8 +126,8 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
 // The same tile, W rays at a time (core/simd_lanes.h: one ray per lane, each composited in its
 // own sample order, so the bits are those of render_tile). The scheduler keeps the lanes full: a
 // lane whose run ends pulls the ray's next run from its cursor; a lane whose ray is done (no runs
-// left, or opaque) writes its pixel and takes the tile's next ray. `march` runs the lanes until
-// one needs the scheduler and returns that lane mask.
+// left, or opaque) writes its pixel and takes the tile's next ray. `march` runs the lanes and
+// calls `refill` with the mask of the lanes that wait.
 constexpr int kMaxTilePixels = 64 * 64;
 
 template <int W, class T, class S, class March>
