@@ -9,7 +9,8 @@
 // TF-independent part (built once per volume): per brick of B^3 cells (B = --leaf, 8) the
 // LUT-entry range of its cells *and a one-cell apron* around them (apron_brick_ranges). Per TF:
 // one bit per brick, whether [lo, hi] holds a visible entry (the min-max octree's prefix-count
-// test, as one lookup: the first visible entry at or after lo is <= hi), packed in blocks of 4x4x4 bricks per uint64 (a zero word is an empty block: the DDA's coarse level, free),
+// test, as one lookup: the first visible entry at or after lo is <= hi), packed in blocks of
+// 4x4x4 bricks per uint64 (a zero word is an empty block: the DDA's coarse level, free),
 // and per block the Chebyshev distance (in blocks) to the nearest block with a visible brick: in
 // empty space the walk leaps out of the whole cube of empty blocks that distance guarantees
 // (Deakin & Knackstedt's distance maps, on the block grid: a few thousand entries, so the map is
