@@ -17,6 +17,40 @@ void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required) {
     cmd.add_option("--type", a.raw_type, "Raw files: voxel type (uint8, int16, uint16, float32)");
     cmd.add_option("--range", a.range,
                    "Visualization range MIN:MAX mapped onto the TF domain (default: data range)");
+    cmd.add_option("--max-memory", a.max_memory,
+                   "Most memory a volume may take, e.g. 12G or 512MB (default: half of physical "
+                   "memory, " +
+                       format_bytes(default_memory_budget()) + " here)");
+    cmd.add_flag("--allow-external-data", a.allow_external_data,
+                 "Let a detached header (.nhdr, .mhd) name a data file outside its folder");
+}
+
+uint64_t parse_bytes(const std::string& s, const std::string& where) {
+    const auto bad = [&] {
+        return Error(where, "size",
+                     "expected a size like 12G, 512MB, 1.5GiB or a byte count, got '" + s + "'");
+    };
+    size_t used = 0;
+    double x = 0;
+    try {
+        x = std::stod(s, &used);
+    } catch (const std::logic_error&) {
+        throw bad();
+    }
+    std::string unit = s.substr(used);
+    if (!unit.empty() && unit.front() == ' ') unit.erase(0, 1);
+    static const std::pair<const char*, double> kUnits[] = {
+        {"", 1},       {"B", 1},      {"k", 1e3},    {"K", 1e3},          {"kB", 1e3},
+        {"KB", 1e3},   {"M", 1e6},    {"MB", 1e6},   {"G", 1e9},          {"GB", 1e9},
+        {"T", 1e12},   {"TB", 1e12},  {"KiB", 1024}, {"MiB", 1048576.0}, {"GiB", 1073741824.0},
+        {"TiB", 1099511627776.0}};
+    for (const auto& [name, scale] : kUnits) {
+        if (unit != name) continue;
+        const double bytes = x * scale;
+        if (!(bytes >= 1) || !(bytes < 1.8e19)) throw bad();
+        return uint64_t(bytes);
+    }
+    throw bad();
 }
 
 Vec3i parse_dims(const std::string& s, const std::string& where) {
@@ -49,6 +83,9 @@ Volume load_volume(const VolumeArgs& a) {
         spec.type = parse_voxel_type(a.raw_type, "--type");
         ro.raw = spec;
     }
+    if (!a.max_memory.empty()) ro.max_memory.bytes = parse_bytes(a.max_memory, "--max-memory");
+    ro.max_memory.name = "--max-memory";
+    ro.allow_external_data = a.allow_external_data;
     Progress progress("loading " + std::filesystem::path(a.path).filename().string());
     ro.progress = [&](double f) { progress.update(f); };
     Volume v = read_volume(a.path, ro);

@@ -17,10 +17,17 @@ struct VolumeArgs {
     std::string raw_dims;  // "301x370x316"
     std::string raw_type;  // "uint8"
     std::string range;     // "MIN:MAX" visualization range override
+    std::string max_memory;  // "12G", "512MB", "1.5GiB", bytes; empty: the default budget
+    bool allow_external_data = false;
 };
 void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required = true);
 // Loads the volume (with a progress line on a terminal) and applies --range.
 Volume load_volume(const VolumeArgs& a);
+
+// Parses a byte count: a number with an optional unit k, M, G, T (powers of 1000) or KiB, MiB,
+// GiB, TiB (powers of 1024), "B" optional: "12G", "512MB", "1.5GiB", "100000". Throws
+// lacuna::Error(where, "size", ...).
+uint64_t parse_bytes(const std::string& s, const std::string& where);
 
 // Parses "AxBxC" into dims; throws lacuna::Error(where, "dims", ...).
 Vec3i parse_dims(const std::string& s, const std::string& where);

@@ -2,6 +2,7 @@
 // MetaImage headers and DICOM series; our own code for NIfTI-1/2, MetaImage voxel data and raw
 // files). Formats, conversions and error messages: docs/formats.md.
 #pragma once
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -17,11 +18,28 @@ struct RawSpec {
     bool big_endian = false;
 };
 
+// The most memory one read may allocate (voxels plus any conversion buffer), checked from the
+// header before anything is allocated. `name` is how errors call the limit, so a front end can
+// name its own flag ("--max-memory") while the library names none.
+struct MemoryBudget {
+    uint64_t bytes = 0;  // 0: default_memory_budget()
+    std::string name = "the memory budget";
+};
+// Half of the physical memory (or of the cgroup's memory.max when that is lower): a volume may
+// take half the machine, the other half is left for skipping structures, images and the rest.
+uint64_t default_memory_budget();
+// "5.4 GB", "120 MB", "17 B": decimal units, two significant digits.
+std::string format_bytes(uint64_t bytes);
+
 struct ReadOptions {
     // For .raw files: explicit layout; when unset, parsed from "name_301x370x316_uint8.raw".
     std::optional<RawSpec> raw;
     // Called with a fraction in [0,1] during long reads (may be null).
     std::function<void(double)> progress;
+    MemoryBudget max_memory;
+    // Detached data files (.nhdr "data file", .mhd ElementDataFile) must be regular files in
+    // the header's folder or below it; true also allows any other regular file.
+    bool allow_external_data = false;
 };
 
 // Reads a volume: .nii/.nii.gz (NIfTI-1/2), .nrrd/.nhdr, .mha/.mhd, a folder of DICOM slices,
@@ -34,9 +52,12 @@ Volume read_volume(const std::string& path, const ReadOptions& opts = {});
 // Parses "name_301x370x316_uint8.raw"-style names; nullopt if the name does not match.
 std::optional<RawSpec> raw_spec_from_name(const std::string& path);
 
-// Writes a volume as .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd or .raw (by extension), atomically
-// (temporary file + rename). A path ending in '/' writes a DICOM series into that folder
-// (integer volumes only; not atomic). Throws lacuna::Error on failure.
+// Writes a volume as .nrrd, .nhdr, .nii, .nii.gz, .mha, .mhd or .raw (by extension), atomically:
+// a temporary file beside the target, its written size checked, fsync'ed, then renamed. A path
+// ending in '/' writes a DICOM series into that folder (integer volumes only; the folder must
+// not exist or be empty, and is renamed into place complete). Temporary files left by dead
+// processes are removed first (docs/formats.md, "Writing"). Throws lacuna::Error on failure
+// and leaves nothing behind.
 void write_volume(const std::string& path, const Volume& v);
 
 }  // namespace lacuna

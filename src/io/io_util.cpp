@@ -1,9 +1,12 @@
 #include "io/io_util.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cinttypes>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -15,9 +18,70 @@
 
 #include "lacuna/error.h"
 
+namespace lacuna {
+
+namespace {
+
+uint64_t physical_memory() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page <= 0) return uint64_t(1) << 34;  // unknown: assume 16 GiB
+    return uint64_t(pages) * uint64_t(page);
+}
+
+// cgroup v2 limit of this process ("max" or absent: no limit).
+uint64_t cgroup_memory_limit() {
+    std::ifstream in("/sys/fs/cgroup/memory.max");
+    uint64_t v = 0;
+    if (in >> v && v > 0) return v;
+    return UINT64_MAX;
+}
+
+}  // namespace
+
+uint64_t default_memory_budget() {
+    return std::min(physical_memory(), cgroup_memory_limit()) / 2;
+}
+
+std::string format_bytes(uint64_t bytes) {
+    static const char* kUnits[] = {"B", "kB", "MB", "GB", "TB", "PB", "EB"};
+    double v = double(bytes);
+    int u = 0;
+    while (v >= 1000.0 && u < 6) {
+        v /= 1000.0;
+        ++u;
+    }
+    char buf[32];
+    if (u == 0 || v >= 10.0)
+        std::snprintf(buf, sizeof buf, "%.0f %s", v, kUnits[u]);
+    else
+        std::snprintf(buf, sizeof buf, "%.1f %s", v, kUnits[u]);
+    return buf;
+}
+
+}  // namespace lacuna
+
 namespace lacuna::io {
 
 namespace fs = std::filesystem;
+
+uint64_t grid_bytes(Vec3i d, uint64_t elem) {
+    const auto dim = [](int x) { return uint64_t(std::max(x, 0)); };
+    return sat_mul(sat_mul(sat_mul(dim(d.x), dim(d.y)), dim(d.z)), elem);
+}
+
+std::string dims_string(Vec3i d) {
+    return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+void check_budget(const std::string& where, const std::string& field, const std::string& what,
+                  uint64_t need, const MemoryBudget& budget) {
+    const uint64_t limit = budget.bytes ? budget.bytes : default_memory_budget();
+    if (need <= limit) return;
+    throw Error(where, field,
+                what + " needs " + (need == UINT64_MAX ? std::string("more than 18 EB")
+                                                       : format_bytes(need)) +
+                    ", more than " + budget.name + " " + format_bytes(limit));
+}
 
 std::string to_lower(std::string s) {
     for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -102,7 +166,55 @@ void remove_temp_files(const TempName& t) noexcept {
         const std::string name = it->path().filename().string();
         if (name.compare(0, t.prefix.size(), t.prefix) == 0) doomed.push_back(it->path());
     }
-    for (const auto& p : doomed) fs::remove(p, ec);
+    for (const auto& p : doomed) fs::remove_all(p, ec);  // a DICOM output folder, too
+}
+
+void remove_stale_temp_files(const std::string& dir) noexcept {
+    std::error_code ec;
+    const long self = long(::getpid());
+    std::vector<fs::path> doomed;
+    for (fs::directory_iterator it(dir.empty() ? "." : dir, ec), end; !ec && it != end;
+         it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        long pid = 0;
+        unsigned n = 0;
+        int used = 0;
+        if (std::sscanf(name.c_str(), ".tmp-%ld-%u-%n", &pid, &n, &used) != 2 || used == 0)
+            continue;
+        if (pid <= 0 || pid == self) continue;
+        if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours)
+        doomed.push_back(it->path());
+    }
+    for (const auto& p : doomed) fs::remove_all(p, ec);
+}
+
+void sync_file(const std::string& path, const std::string& where) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    int err = fd < 0 ? errno : 0;
+    if (fd >= 0) {
+        if (::fsync(fd) != 0) err = errno;
+        if (::close(fd) != 0 && !err) err = errno;
+    }
+    if (err) throw Error(where, "output", std::string("cannot write: fsync: ") + std::strerror(err));
+}
+
+void sync_dir(const std::string& dir) noexcept {
+    const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return;
+    ::fsync(fd);
+    ::close(fd);
+}
+
+void expect_file_size(const std::string& path, uint64_t expected, const std::string& where,
+                      bool at_least) {
+    std::error_code ec;
+    const uint64_t got = fs::file_size(path, ec);
+    if (ec) throw Error(where, "output", "cannot write: " + ec.message());
+    if (got == expected || (at_least && got > expected)) return;
+    throw Error(where, "output",
+                "cannot write: the file has " + std::to_string(got) + " bytes, expected " +
+                    (at_least ? "at least " : "") + std::to_string(expected) +
+                    " (disk full or file size limit?)");
 }
 
 void rename_over(const std::string& from, const std::string& to) {
@@ -113,16 +225,22 @@ void rename_over(const std::string& from, const std::string& to) {
 
 void write_text_atomic(const std::string& path, const std::string& text) {
     const TempName tmp = temp_name_beside(path);
-    {
-        std::ofstream f(tmp.path, std::ios::binary);
-        f << text;
-        f.flush();
-        if (!f) {
-            remove_temp_files(tmp);
-            throw Error(path, "output", "cannot write the file");
+    remove_stale_temp_files(tmp.dir);
+    try {
+        {
+            std::ofstream f(tmp.path, std::ios::binary);
+            f << text;
+            f.flush();
+            if (!f) throw Error(path, "output", "cannot write the file");
         }
+        expect_file_size(tmp.path, text.size(), path);
+        sync_file(tmp.path, path);
+        rename_over(tmp.path, path);
+        sync_dir(tmp.dir);
+    } catch (...) {
+        remove_temp_files(tmp);
+        throw;
     }
-    rename_over(tmp.path, path);
 }
 
 size_t disk_type_size(DiskType t) {

@@ -5,9 +5,29 @@
 #include <functional>
 #include <string>
 
+#include "lacuna/io.h"
 #include "lacuna/volume.h"
 
 namespace lacuna::io {
+
+// Overflow-safe size arithmetic: sizes come from files and may be anything. Both saturate at
+// UINT64_MAX, which no budget or file size reaches, so a saturated result always fails the
+// check it feeds.
+inline uint64_t sat_add(uint64_t a, uint64_t b) {
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+inline uint64_t sat_mul(uint64_t a, uint64_t b) {
+    return b != 0 && a > UINT64_MAX / b ? UINT64_MAX : a * b;
+}
+// Bytes of a dims.x * dims.y * dims.z grid of `elem`-byte voxels (saturating; dims >= 0).
+uint64_t grid_bytes(Vec3i dims, uint64_t elem);
+std::string dims_string(Vec3i dims);  // "30000x30000x3"
+
+// The memory check every reader makes from the header, before allocating anything: throws
+// Error(where, field, "<what> needs 5.4 GB, more than <budget.name> 12 GB") when `need`
+// exceeds the budget. `what` names the allocation, e.g. "30000x30000x3 int16".
+void check_budget(const std::string& where, const std::string& field, const std::string& what,
+                  uint64_t need, const MemoryBudget& budget);
 
 std::string to_lower(std::string s);
 
@@ -36,11 +56,27 @@ struct TempName {
 TempName temp_name_beside(const std::string& path);
 // Removes every file in t.dir whose name starts with t.prefix (cleanup after a failed write).
 void remove_temp_files(const TempName& t) noexcept;
+// Removes temporaries that dead writers left in `dir`: entries named ".tmp-<pid>-<n>-..." whose
+// <pid> is not this process and names no live process (kill(pid, 0) fails with ESRCH). A pid
+// that was reused by an unrelated live process keeps its debris until that process ends: the
+// rule never removes a file a live writer may still be filling. Best effort, never throws.
+void remove_stale_temp_files(const std::string& dir) noexcept;
+// fsync(2)s a written file before it is renamed into place; throws
+// Error(where, "output", "cannot write: fsync: <strerror>").
+void sync_file(const std::string& path, const std::string& where);
+// fsync(2)s a folder after a rename in it, so the new name survives a crash. Best effort: the
+// file is complete and in place already, so a failure here is not reported.
+void sync_dir(const std::string& dir) noexcept;
+// Throws Error(where, "output", "cannot write: ... has N bytes, expected M (disk full?)")
+// unless `path` has exactly `expected` bytes (at least, when `at_least`). Catches writers that
+// report a short write only on stderr (ITK's), or not at all.
+void expect_file_size(const std::string& path, uint64_t expected, const std::string& where,
+                      bool at_least = false);
 // Renames `from` over `to`; throws Error(to, "output", ...) on failure.
 void rename_over(const std::string& from, const std::string& to);
-// Writes `text` to `path` atomically: a temporary file beside it (temp_name_beside), then
-// rename_over. On a failed write the temporary file is removed and Error(path, "output", ...)
-// is thrown, so nothing is left half-written.
+// Writes `text` to `path` atomically: a temporary file beside it (temp_name_beside), checked,
+// fsync'ed, then rename_over. On a failed write the temporary file is removed and
+// Error(path, "output", ...) is thrown, so nothing is left half-written.
 void write_text_atomic(const std::string& path, const std::string& text);
 
 // Calls progress(f) if set; exceptions from the callback propagate.

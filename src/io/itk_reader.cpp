@@ -11,6 +11,7 @@
 #include <new>
 #include <optional>
 
+#include "io/detached_data.h"
 #include "io/itk_support.h"
 #include "io/metaimage_data.h"
 #include "io/readers.h"
@@ -105,7 +106,14 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     }
     if (!readable) throw fail("header", "not a valid " + format_name(path) + " file");
 
+    // Our checks of the header run before ITK parses it (docs/formats.md): NDims for MetaIO,
+    // and where a detached NRRD header's data files are.
     if (dynamic_cast<itk::MetaImageIO*>(io.GetPointer())) check_metaimage_header(path);
+    if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
+        quiet.reset();
+        check_nrrd_data_files(path, opts.allow_external_data);
+        quiet.emplace();
+    }
     try {
         io->SetFileName(path);
         io->ReadImageInformation();
@@ -116,6 +124,13 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     const Vec3i dims = checked_dims(*io, path);
     const DiskType disk = disk_type_from_itk(io->GetComponentType(), path);
     const size_t voxels = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
+    // NRRD voxels that need conversion pass through a full-size temporary of the file's type.
+    const bool nrrd_converts = !dynamic_cast<itk::MetaImageIO*>(io.GetPointer()) &&
+                               disk != disk_type_of(stored_type(disk));
+    check_budget(path, "dims", dims_string(dims) + " " + to_string(disk),
+                 sat_add(grid_bytes(dims, voxel_size(stored_type(disk))),
+                         nrrd_converts ? grid_bytes(dims, disk_type_size(disk)) : 0),
+                 opts.max_memory);
 
     // MetaImage: locate the voxels ourselves (see metaimage_data.cpp) and, for uncompressed
     // data, check the length before allocating.
@@ -124,7 +139,8 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
         MetaImage* mi = mio->GetMetaImagePointer();
         meta = metaimage_layout(path, mi->ElementDataFileName(), mi->HeaderSize(),
                                 mi->CompressedData(), mi->BinaryData(),
-                                mi->BinaryDataByteOrderMSB(), voxels * disk_type_size(disk));
+                                mi->BinaryDataByteOrderMSB(), voxels * disk_type_size(disk),
+                                opts.allow_external_data);
     }
 
     Volume v(dims, stored_type(disk), path);

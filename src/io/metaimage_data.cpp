@@ -17,6 +17,7 @@
 #include <fstream>
 #include <vector>
 
+#include "io/detached_data.h"
 #include "lacuna/error.h"
 
 namespace lacuna::io {
@@ -111,19 +112,25 @@ void check_metaimage_header(const std::string& path) {
 std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,
                                                const std::string& data_file, int header_size,
                                                bool compressed, bool binary, bool msb,
-                                               size_t data_bytes) {
+                                               size_t data_bytes, bool allow_external) {
+    const bool local = data_file == "LOCAL";
+    if (!local) {
+        if (data_file.empty() || data_file.rfind("LIST", 0) == 0 ||
+            data_file.find('%') != std::string::npos || data_file.find(' ') != std::string::npos)
+            throw Error(header_path, "ElementDataFile",
+                        "expected LOCAL or one data file name, got '" + one_line(data_file, 120) +
+                            "' (slice lists and name patterns are not supported)");
+        check_data_file(header_path, "ElementDataFile", data_file, allow_external);
+    }
     if (!binary) return std::nullopt;  // ASCII voxels: MetaIO parses them
     MetaDataLayout l;
     l.compressed = compressed;
     l.swap = msb != host_is_big_endian();
-    if (data_file == "LOCAL") {
+    if (local) {
         l.path = header_path;
         l.offset = local_data_offset(header_path);
         if (l.offset < 0) return std::nullopt;
     } else {
-        if (data_file.empty() || data_file.rfind("LIST", 0) == 0 ||
-            data_file.find('%') != std::string::npos || data_file.find(' ') != std::string::npos)
-            return std::nullopt;
         const fs::path p(data_file);
         l.path = p.is_absolute() ? p.string() : (fs::path(header_path).parent_path() / p).string();
         l.offset = 0;
@@ -136,7 +143,7 @@ std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,
                         ec.message());
     if (header_size > 0) l.offset += header_size;
     if (header_size == -1 && !compressed) l.offset = int64_t(size) - int64_t(data_bytes);
-    if (!compressed && (l.offset < 0 || size < uint64_t(l.offset) + data_bytes))
+    if (!compressed && (l.offset < 0 || size < sat_add(uint64_t(l.offset), data_bytes)))
         throw Error(header_path, "voxel data",
                     "truncated: expected " + std::to_string(data_bytes) +
                         " bytes of voxels, the data file has " +

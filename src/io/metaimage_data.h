@@ -22,13 +22,15 @@ struct MetaDataLayout {
 // Throws Error(path, "header", ...) unless NDims is 3 or 4. Call before ITK reads the header.
 void check_metaimage_header(const std::string& path);
 
-// Locates the voxel data described by a parsed MetaImage header; nullopt for layouts left to
-// MetaIO. For uncompressed data, throws Error(header_path, "voxel data", "truncated: ...")
-// when the file is shorter than `data_bytes` — before anything is allocated.
+// Locates the voxel data described by a parsed MetaImage header; nullopt for ASCII voxels,
+// which MetaIO parses. An external data file must pass check_data_file (detached_data.h);
+// slice lists and file-name patterns are rejected. For uncompressed data, throws
+// Error(header_path, "voxel data", "truncated: ...") when the file is shorter than
+// `data_bytes` — before anything is allocated.
 std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,
                                                const std::string& data_file, int header_size,
                                                bool compressed, bool binary, bool msb,
-                                               size_t data_bytes);
+                                               size_t data_bytes, bool allow_external);
 
 // Reads (inflating if needed) the voxels into v, converting from `disk`.
 void read_metaimage_voxels(const MetaDataLayout& layout, DiskType disk, Volume& v,

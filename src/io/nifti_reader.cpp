@@ -380,14 +380,18 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     const bool rescale = std::isfinite(h.slope) && std::isfinite(h.inter) && h.slope != 0.0 &&
                          (h.slope != 1.0 || h.inter != 0.0);
     const VoxelType type = rescale ? VoxelType::Float32 : stored_type(disk);
-    const size_t data_bytes =
-        size_t(dims.x) * size_t(dims.y) * size_t(dims.z) * disk_type_size(disk);
+    // dims are 2..kMaxDim each, so these products fit; sat_add guards a wild vox_offset.
+    const uint64_t data_bytes = grid_bytes(dims, disk_type_size(disk));
+    check_budget(path, "dims", dims_string(dims) + " " + to_string(type), grid_bytes(dims, voxel_size(type)),
+                 opts.max_memory);
 
-    // An uncompressed file's length is known: report truncation before allocating.
+    // An uncompressed file's length is known: report truncation before allocating. A
+    // compressed one is inflated incrementally into the buffer, whose pages are only touched
+    // as data arrives (Volume's constructor), so a short stream fails as fast as it ends.
     if (gzdirect(f.get())) {
         std::error_code ec;
         const auto file_bytes = std::filesystem::file_size(path, ec);
-        if (!ec && file_bytes < uint64_t(h.vox_offset) + data_bytes)
+        if (!ec && file_bytes < sat_add(uint64_t(h.vox_offset), data_bytes))
             throw Error(path, "voxel data",
                         "truncated: expected " + std::to_string(data_bytes) +
                             " bytes of voxels after offset " + std::to_string(h.vox_offset) +

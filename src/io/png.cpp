@@ -4,6 +4,7 @@
 // every setjmp lives in a function whose locals are plain pointers and ints, and the C++
 // side (temporary file names, exceptions) stays outside it.
 #include <png.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -118,11 +119,14 @@ void write_png(const std::string& path, const Image& img) {
                         " bytes");
     io::check_writable_dir(path);
     const io::TempName tmp = io::temp_name_beside(path);
+    io::remove_stale_temp_files(tmp.dir);
     FILE* fp = std::fopen(tmp.path.c_str(), "wb");
     if (!fp) throw Error(path, "output", std::string("cannot write: ") + std::strerror(errno));
     PngMessage msg;
     const int rc = encode_png(fp, img, msg);
-    const int flush_errno = std::fflush(fp) != 0 ? errno : 0;
+    const int flush_errno = std::fflush(fp) != 0                 ? errno
+                            : rc == 0 && ::fsync(::fileno(fp)) != 0 ? errno
+                                                                    : 0;
     const bool io_error = std::ferror(fp) != 0;
     const int close_errno = std::fclose(fp) != 0 ? errno : 0;
     if (rc != 0 || io_error || flush_errno || close_errno) {
@@ -138,6 +142,7 @@ void write_png(const std::string& path, const Image& img) {
         std::remove(tmp.path.c_str());
         throw Error(path, "output", std::string("cannot write: ") + std::strerror(e));
     }
+    io::sync_dir(tmp.dir);
 }
 
 Image read_png(const std::string& path) {

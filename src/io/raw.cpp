@@ -56,9 +56,10 @@ Volume read_raw(const std::string& path, const ReadOptions& opts) {
             throw Error(path, "spacing",
                         "expected positive spacing, got " + to_string(spec->spacing));
     }
-    // The size check comes before the allocation, so a wrong name costs nothing.
-    const uint64_t expected = uint64_t(spec->dims.x) * uint64_t(spec->dims.y) *
-                              uint64_t(spec->dims.z) * voxel_size(spec->type);
+    // The size and budget checks come before the allocation, so a wrong name costs nothing.
+    const uint64_t expected = grid_bytes(spec->dims, voxel_size(spec->type));
+    check_budget(path, "dims", dims_string(spec->dims) + " " + to_string(spec->type), expected,
+                 opts.max_memory);
     std::error_code ec;
     const uint64_t actual = std::filesystem::file_size(path, ec);
     if (ec) throw Error(path, "file", "cannot read its size: " + ec.message());
@@ -86,6 +87,7 @@ Volume read_raw(const std::string& path, const ReadOptions& opts) {
 void write_raw(const std::string& path, const Volume& v) {
     check_writable_dir(path);
     const TempName tmp = temp_name_beside(path);
+    remove_stale_temp_files(tmp.dir);
     try {
         {
             std::ofstream out(tmp.path, std::ios::binary | std::ios::trunc);
@@ -99,7 +101,10 @@ void write_raw(const std::string& path, const Volume& v) {
             if (!out)
                 throw Error(path, "output", std::string("cannot write: ") + std::strerror(errno));
         }
+        expect_file_size(tmp.path, v.bytes(), path);
+        sync_file(tmp.path, path);
         rename_over(tmp.path, path);
+        sync_dir(tmp.dir);
     } catch (...) {
         remove_temp_files(tmp);
         throw;

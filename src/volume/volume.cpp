@@ -68,13 +68,16 @@ static void check_dims(Vec3i dims, VoxelType type, const std::string& where) {
 
 Volume::Volume(Vec3i dims, VoxelType type, const std::string& where) : m_dims(dims), m_type(type) {
     check_dims(dims, type, where);
-    size_t n = bytes();
-    // 64-byte aligned so SIMD loads of rows are cheap.
-    void* p = std::aligned_alloc(64, (n + 63) / 64 * 64);
-    if (!p) throw Error(where, "memory", "could not allocate " + std::to_string(n >> 20) + " MiB");
-    std::memset(p, 0, n);
-    m_owner = std::shared_ptr<void>(p, [](void* q) { std::free(q); });
-    m_data = p;
+    const size_t n = bytes();
+    // Zeroed by calloc, not memset: a large calloc is fresh mmap'ed pages that the kernel zeroes
+    // when first touched, so a reader that fails early (a tiny .nii.gz claiming 30000^3) costs
+    // address space, not memory or time. 64 spare bytes align the data for SIMD row loads.
+    void* raw = std::calloc(n + 64, 1);
+    if (!raw)
+        throw Error(where, "memory", "could not allocate " + std::to_string(n >> 20) + " MiB");
+    const uintptr_t aligned = (reinterpret_cast<uintptr_t>(raw) + 63) & ~uintptr_t(63);
+    m_owner = std::shared_ptr<void>(raw, [](void* q) { std::free(q); });
+    m_data = reinterpret_cast<void*>(aligned);
 }
 
 Volume::Volume(Vec3i dims, VoxelType type, std::shared_ptr<void> owner, void* data)

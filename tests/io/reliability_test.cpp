@@ -1,0 +1,424 @@
+// Regression tests for issue 15, part B (docs/reliability.md, "Readers"): the memory budget,
+// DICOM folders that used to abort or drop slices, writers on a full disk, stale temporaries
+// and detached headers that pointed anywhere. Every input is generated here, small.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "apps/cli_run.h"
+#include "io/io_test_util.h"
+#include "io/nifti_test_file.h"
+#include "lacuna/image.h"
+#include "lacuna/io.h"
+
+namespace lacuna {
+namespace {
+
+namespace fs = std::filesystem;
+using test::NiftiSpec;
+using test::ScratchDir;
+
+// The error's message, checked to be one line naming `name`.
+std::string read_error(const std::string& path, const ReadOptions& opts = {}) {
+    const std::string msg = test::error_of([&] { read_volume(path, opts); });
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_NE(msg.find(fs::path(path).filename().string()), std::string::npos) << msg;
+    return msg;
+}
+
+uint64_t status_kb(const char* key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind(key, 0) == 0) return std::strtoull(line.c_str() + std::strlen(key), nullptr, 10);
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Memory budget
+
+// The 142-byte .nii.gz of the issue: a header claiming 30000x30000x3 int16 (5.4 GB), no data.
+std::vector<uint8_t> huge_claim_nii_gz() {
+    NiftiSpec spec;
+    spec.dims = {30000, 30000, 3};
+    spec.datatype = 4;  // int16
+    const uint8_t vox[16] = {};
+    return test::gzip(test::nifti_bytes(spec, vox, sizeof vox));
+}
+
+TEST(IoBudget, TinyNiiGzClaimingAHugeVolumeFailsWithoutTouchingMemory) {
+    ScratchDir dir;
+    const std::vector<uint8_t> gz = huge_claim_nii_gz();
+    EXPECT_LT(gz.size(), 200u);
+    test::write_bytes(dir.file("claim.nii.gz"), gz);
+    ReadOptions big;
+    big.max_memory.bytes = uint64_t(8) << 30;  // the claim fits, so the reader must try
+    // Peak resident memory from here on ("5" resets VmHWM, proc(5)).
+    { std::ofstream("/proc/self/clear_refs") << "5"; }
+    const uint64_t before = status_kb("VmRSS:");
+    const std::string msg = read_error(dir.file("claim.nii.gz"), big);
+    const uint64_t peak = status_kb("VmHWM:");
+    EXPECT_NE(msg.find("truncated"), std::string::npos) << msg;
+    ASSERT_GT(peak, 0u) << "/proc/self/status has no VmHWM";
+    EXPECT_LT(peak - std::min(peak, before), uint64_t(50) << 10) << "kB touched by the reader";
+}
+
+TEST(IoBudget, ErrorNamesTheNeedAndTheBudget) {
+    ScratchDir dir;
+    test::write_bytes(dir.file("claim.nii.gz"), huge_claim_nii_gz());
+    ReadOptions small;
+    small.max_memory = {uint64_t(12) * 1000 * 1000 * 1000, "--max-memory"};
+    small.max_memory.bytes = uint64_t(1) << 30;
+    const std::string msg = read_error(dir.file("claim.nii.gz"), small);
+    EXPECT_NE(msg.find("claim.nii.gz: dims: 30000x30000x3 int16 needs 5.4 GB, more than "
+                       "--max-memory 1.1 GB"),
+              std::string::npos)
+        << msg;
+}
+
+TEST(IoBudget, EveryReaderChecksTheBudgetBeforeAllocating) {
+    ScratchDir dir;
+    const Volume v = test::pattern_volume({16, 16, 16}, VoxelType::Int16);  // 8192 bytes
+    for (const char* name : {"v.nii", "v.nii.gz", "v.nrrd", "v.nhdr", "v.mha", "v.mhd",
+                             "v_16x16x16_int16.raw", "series/"}) {
+        SCOPED_TRACE(name);
+        const std::string path = dir.file(name);
+        write_volume(path, v);
+        // DICOM also stages one slice (16x16 int16, 512 bytes).
+        const bool dicom = std::string(name) == "series/";
+        ReadOptions tight, enough;
+        tight.max_memory.bytes = dicom ? 8703 : 8191;
+        enough.max_memory.bytes = dicom ? 8704 : 8192;
+        const std::string msg = test::error_of([&] { read_volume(path, tight); });
+        EXPECT_NE(msg.find(std::string("needs ") + (dicom ? "8.7" : "8.2") +
+                           " kB, more than the memory budget"),
+                  std::string::npos)
+            << msg;
+        EXPECT_TRUE(test::same_voxels(read_volume(path, enough), v));
+    }
+}
+
+TEST(IoBudget, DefaultIsHalfThePhysicalMemoryAtMost) {
+    const uint64_t phys = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGE_SIZE));
+    EXPECT_GT(default_memory_budget(), 0u);
+    EXPECT_LE(default_memory_budget(), phys / 2);
+    EXPECT_EQ(format_bytes(5400000000ull), "5.4 GB");
+    EXPECT_EQ(format_bytes(12300000000ull), "12 GB");
+    EXPECT_EQ(format_bytes(999), "999 B");
+}
+
+TEST(IoBudget, WildNifti2OffsetsDoNotOverflow) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.version = 2;
+    const uint8_t vox[8] = {};
+    std::vector<uint8_t> bytes = test::nifti_bytes(spec, vox, sizeof vox);
+    const int64_t wild = std::numeric_limits<int64_t>::max() - 3;  // vox_offset at byte 168
+    std::memcpy(&bytes[168], &wild, sizeof wild);
+    test::write_bytes(dir.file("wild.nii"), bytes);
+    EXPECT_NE(read_error(dir.file("wild.nii")).find("truncated"), std::string::npos);
+}
+
+TEST(IoBudget, CliTakesMaxMemoryAndNamesIt) {
+    ScratchDir dir;
+    test::write_bytes(dir.file("claim.nii.gz"), huge_claim_nii_gz());
+    const auto r = test::run_cli("info " + dir.file("claim.nii.gz") + " --max-memory 2G", dir.path());
+    test::expect_one_line_error(r, "needs 5.4 GB, more than --max-memory 2.0 GB");
+    const auto bad = test::run_cli("info " + dir.file("claim.nii.gz") + " --max-memory lots", dir.path());
+    test::expect_one_line_error(bad, "--max-memory: size: expected a size like 12G");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Detached headers
+
+std::string nhdr(const std::string& data_line) {
+    return "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n" + data_line + "\n\n";
+}
+std::string mhd(const std::string& data) {
+    return "ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\n"
+           "ElementDataFile = " + data + "\n";
+}
+
+TEST(IoDetached, DataFileOutsideTheHeadersFolderNeedsPermission) {
+    ScratchDir dir, other;
+    test::write_bytes(other.file("data.raw"), std::vector<uint8_t>(64, 7));
+    fs::create_directory(dir.path() / "h");
+    test::write_text(dir.file("h/a.nhdr"), nhdr("data file: " + other.file("data.raw")));
+    test::write_text(dir.file("h/a.mhd"), mhd(other.file("data.raw")));
+    test::write_bytes(dir.file("up.raw"), std::vector<uint8_t>(64, 7));
+    test::write_text(dir.file("h/b.nhdr"), nhdr("data file: ../up.raw"));
+    test::write_text(dir.file("h/b.mhd"), mhd("../up.raw"));
+    fs::create_symlink(dir.file("up.raw"), dir.file("h/link.raw"));  // escapes by a symlink
+    test::write_text(dir.file("h/c.nhdr"), nhdr("data file: link.raw"));
+    ReadOptions allow;
+    allow.allow_external_data = true;
+    for (const char* h : {"h/a.nhdr", "h/a.mhd", "h/b.nhdr", "h/b.mhd", "h/c.nhdr"}) {
+        SCOPED_TRACE(h);
+        EXPECT_NE(read_error(dir.file(h)).find("is outside the header's folder"), std::string::npos);
+        const Volume v = read_volume(dir.file(h), allow);
+        EXPECT_EQ(v.data_as<uint8_t>()[63], 7);
+    }
+}
+
+TEST(IoDetached, DataFileMustBeARegularFileEvenWhenExternalIsAllowed) {
+    ScratchDir dir;
+    fs::create_symlink("/dev/zero", dir.file("zero.raw"));
+    test::write_text(dir.file("z.nhdr"), nhdr("data file: zero.raw"));
+    test::write_text(dir.file("z.mhd"), mhd("zero.raw"));
+    test::write_text(dir.file("u.mhd"), mhd("/dev/urandom"));
+    test::write_text(dir.file("p.nhdr"), nhdr("data file: /etc/passwd"));
+    fs::create_directory(dir.path() / "folder.raw");
+    test::write_text(dir.file("d.mhd"), mhd("folder.raw"));
+    ReadOptions allow;
+    allow.allow_external_data = true;
+    for (const char* h : {"z.nhdr", "z.mhd", "u.mhd", "d.mhd"}) {
+        SCOPED_TRACE(h);
+        EXPECT_NE(read_error(dir.file(h), allow).find("is not a regular file"), std::string::npos);
+    }
+    EXPECT_NE(read_error(dir.file("p.nhdr")).find("outside"), std::string::npos);
+}
+
+TEST(IoDetached, DataFilesBelowTheHeaderAreRead) {
+    ScratchDir dir;
+    fs::create_directories(dir.path() / "sub" / "deeper");
+    test::write_bytes(dir.file("sub/deeper/d.raw"), std::vector<uint8_t>(64, 9));
+    test::write_text(dir.file("a.nhdr"), nhdr("data file: sub/deeper/d.raw"));
+    test::write_text(dir.file("a.mhd"), mhd("sub/deeper/d.raw"));
+    EXPECT_EQ(read_volume(dir.file("a.nhdr")).data_as<uint8_t>()[0], 9);
+    EXPECT_EQ(read_volume(dir.file("a.mhd")).data_as<uint8_t>()[0], 9);
+}
+
+TEST(IoDetached, NrrdListsAndPatternsAreCheckedFileByFile) {
+    ScratchDir dir;
+    for (int z = 0; z < 4; ++z)
+        test::write_bytes(dir.file("s" + std::to_string(z) + ".raw"), std::vector<uint8_t>(16, 3));
+    const std::string sizes = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n";
+    test::write_text(dir.file("pattern.nhdr"), sizes + "data file: s%d.raw 0 3 1 2\n\n");
+    EXPECT_EQ(read_volume(dir.file("pattern.nhdr")).data_as<uint8_t>()[63], 3);
+    test::write_text(dir.file("list.nhdr"),
+                     sizes + "data file: LIST 2\n\ns0.raw\ns1.raw\ns2.raw\n/etc/passwd\n");
+    EXPECT_NE(read_error(dir.file("list.nhdr")).find("'/etc/passwd' is outside"), std::string::npos);
+    test::write_text(dir.file("fmt.nhdr"), sizes + "data file: %s%n.raw 0 3 1 2\n\n");
+    EXPECT_NE(read_error(dir.file("fmt.nhdr")).find("one %d"), std::string::npos);
+    test::write_text(dir.file("mhdlist.mhd"), mhd("LIST"));
+    EXPECT_NE(read_error(dir.file("mhdlist.mhd")).find("ElementDataFile"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writers
+
+// Runs f in a child whose files may not grow beyond `limit` bytes (RLIMIT_FSIZE, with SIGXFSZ
+// ignored so write(2) fails with EFBIG, as on a full disk). Returns the child's exit code:
+// 0 when f threw a lacuna::Error naming `name` on one line, 1 when f succeeded, 2 otherwise.
+int with_file_size_limit(rlim_t limit, const std::string& name, const std::function<void()>& f) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::signal(SIGXFSZ, SIG_IGN);
+        rlimit r{limit, limit};
+        ::setrlimit(RLIMIT_FSIZE, &r);
+        try {
+            f();
+        } catch (const Error& e) {
+            const std::string m = e.what();
+            ::_exit(m.find('\n') == std::string::npos && m.find(name) != std::string::npos ? 0 : 2);
+        } catch (...) {
+            ::_exit(2);
+        }
+        ::_exit(1);
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 100 + WTERMSIG(status);
+}
+
+TEST(IoWriterFullDisk, EveryWriterFailsAndLeavesNothing) {
+    const Volume v = test::pattern_volume({64, 64, 16}, VoxelType::Int16);  // 128 KiB
+    for (const char* name : {"v.nii", "v.nii.gz", "v.nrrd", "v.nhdr", "v.mha", "v.mhd", "v.raw",
+                             "series/"}) {
+        // Below a header, inside one, and below one DICOM slice (8 KiB) and the files (128 KiB).
+        for (rlim_t limit : {rlim_t(0), rlim_t(300), rlim_t(5000)}) {
+            SCOPED_TRACE(std::string(name) + " limit " + std::to_string(limit));
+            ScratchDir dir;
+            EXPECT_EQ(with_file_size_limit(limit, name[0] == 's' ? "series" : name,
+                                           [&] { write_volume(dir.file(name), v); }),
+                      0);
+            EXPECT_EQ(dir.names(), std::vector<std::string>{}) << "left behind";
+        }
+    }
+}
+
+TEST(IoWriterFullDisk, PngFailsAndLeavesNothing) {
+    ScratchDir dir;
+    Image img(256, 256);
+    for (size_t i = 0; i < img.rgba.size(); ++i) img.rgba[i] = uint8_t(i * 2654435761u >> 13);
+    EXPECT_EQ(with_file_size_limit(1000, "f.png", [&] { write_png(dir.file("f.png"), img); }), 0);
+    EXPECT_EQ(dir.names(), std::vector<std::string>{});
+}
+
+TEST(IoWriter, RemovesTemporariesOfDeadProcessesOnly) {
+    ScratchDir dir;
+    const pid_t dead = ::fork();
+    if (dead == 0) ::_exit(0);
+    ::waitpid(dead, nullptr, 0);
+    const std::string stale = ".tmp-" + std::to_string(dead) + "-0-old.nii";
+    const std::string stale_dir = ".tmp-" + std::to_string(dead) + "-1-series";
+    const std::string live = ".tmp-1-0-init.nii";  // pid 1 is alive
+    const std::string mine = ".tmp-" + std::to_string(::getpid()) + "-99999-mine.nii";
+    for (const auto& n : {stale, live, mine, std::string(".tmp-x-notours")})
+        test::write_text(dir.file(n), "partial");
+    fs::create_directory(dir.path() / stale_dir);
+    test::write_text(dir.file(stale_dir + "/slice_00000.dcm"), "partial");
+    write_volume(dir.file("new.nrrd"), test::pattern_volume({4, 4, 4}, VoxelType::UInt8));
+    std::vector<std::string> kept{mine, live, ".tmp-x-notours", "new.nrrd"};
+    std::sort(kept.begin(), kept.end());
+    EXPECT_EQ(dir.names(), kept);
+}
+
+TEST(IoWriter, DicomOutputNeedsANewOrEmptyFolder) {
+    ScratchDir dir;
+    const Volume v = test::pattern_volume({8, 8, 3}, VoxelType::UInt16);
+    fs::create_directory(dir.path() / "full");
+    test::write_text(dir.file("full/keep.txt"), "mine");
+    const std::string msg = test::error_of([&] { write_volume(dir.file("full") + "/", v); });
+    EXPECT_NE(msg.find("not an empty folder"), std::string::npos) << msg;
+    EXPECT_EQ(fs::directory_iterator(dir.path() / "full")->path().filename(), "keep.txt");
+    fs::create_directory(dir.path() / "empty");
+    write_volume(dir.file("empty") + "/", v);
+    EXPECT_TRUE(test::same_voxels(read_volume(dir.file("empty")), v));
+    EXPECT_EQ(dir.names(), (std::vector<std::string>{"empty", "full"}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// DICOM folders
+
+std::string write_series(const ScratchDir& dir, const std::string& name, int slices = 5) {
+    const Volume v = test::pattern_volume({8, 8, slices}, VoxelType::Int16);
+    write_volume(dir.file(name) + "/", v);
+    return dir.file(name);
+}
+
+TEST(IoDicomFolder, DeviceOrFifoOrBrokenLinkInTheFolderIsAnError) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s");
+    EXPECT_EQ(read_volume(s).dims(), (Vec3i{8, 8, 5}));
+    fs::create_symlink("/dev/zero", s + "/zero.dcm");
+    std::string msg = read_error(s);
+    EXPECT_NE(msg.find("zero.dcm: is a character device"), std::string::npos) << msg;
+    fs::remove(s + "/zero.dcm");
+    ASSERT_EQ(::mkfifo((s + "/pipe.dcm").c_str(), 0600), 0);
+    msg = read_error(s);
+    EXPECT_NE(msg.find("pipe.dcm: is a FIFO"), std::string::npos) << msg;
+    fs::remove(s + "/pipe.dcm");
+    fs::create_symlink(s + "/gone.dcm", s + "/dangling.dcm");
+    msg = read_error(s);
+    EXPECT_NE(msg.find("dangling.dcm: is a symbolic link to nothing"), std::string::npos) << msg;
+}
+
+TEST(IoDicomFolder, MissingSliceIsAGap) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s");
+    fs::remove(s + "/slice_00002.dcm");
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("missing or extra slice"), std::string::npos) << msg;
+}
+
+TEST(IoDicomFolder, DuplicateSlicePositionIsAnError) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s");
+    fs::copy_file(s + "/slice_00002.dcm", s + "/copy.dcm");
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("duplicates the position"), std::string::npos) << msg;
+}
+
+TEST(IoDicomFolder, DamagedSlicesAreErrorsNeverAborts) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    const std::string victim = s + "/slice_00001.dcm";
+    const std::vector<uint8_t> good = test::file_bytes(victim);
+    std::mt19937 rng(15);
+    int errors = 0, reads = 0;
+    for (int trial = 0; trial < 60; ++trial) {
+        std::vector<uint8_t> bad = good;
+        if (trial % 3 == 0) {
+            bad.resize(rng() % good.size());
+        } else {
+            // Damage the meta header and the first elements, where the lengths live.
+            for (int k = 0; k < 1 + trial % 7; ++k) bad[128 + rng() % 400] = uint8_t(rng());
+        }
+        test::write_bytes(victim, bad);
+        try {
+            read_volume(s);
+            ++reads;
+        } catch (const Error& e) {
+            const std::string m = e.what();
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+            EXPECT_NE(m.find(s), std::string::npos) << m;
+            ++errors;
+        }
+    }
+    EXPECT_GT(errors, 0);
+    EXPECT_EQ(errors + reads, 60);
+}
+
+// Offset of the Pixel Data length field in a slice written by lacuna (implicit or explicit VR).
+size_t pixel_length_offset(const std::vector<uint8_t>& bytes) {
+    const uint8_t tag[] = {0xe0, 0x7f, 0x10, 0x00};
+    const auto it = std::find_end(bytes.begin(), bytes.end(), std::begin(tag), std::end(tag));
+    EXPECT_NE(it, bytes.end());
+    const size_t at = size_t(it - bytes.begin());
+    const bool explicit_vr = bytes[at + 4] == 'O' && (bytes[at + 5] == 'W' || bytes[at + 5] == 'B');
+    return at + (explicit_vr ? 8 : 4);
+}
+
+TEST(IoDicomFolder, HugeDamagedLengthIsAnErrorBeforeGdcmAllocates) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    const std::string victim = s + "/slice_00001.dcm";
+    std::vector<uint8_t> bytes = test::file_bytes(victim);
+    const uint32_t huge = 0x30000000;  // 805 MB, in a file of about a kilobyte
+    std::memcpy(&bytes[pixel_length_offset(bytes)], &huge, 4);
+    test::write_bytes(victim, bytes);
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("slice_00001.dcm: element (7FE0,0010) says 805306368 bytes"),
+              std::string::npos)
+        << msg;
+}
+
+TEST(IoDicomFolder, ShortPixelDataIsAnErrorNotAShortSlice) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    const std::string victim = s + "/slice_00001.dcm";
+    std::vector<uint8_t> bytes = test::file_bytes(victim);
+    const size_t len_at = pixel_length_offset(bytes);
+    const uint32_t shorter = 64;  // an 8x8 int16 slice needs 128
+    std::memcpy(&bytes[len_at], &shorter, 4);
+    bytes.resize(len_at + 4 + shorter);
+    test::write_bytes(victim, bytes);
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("slice_00001.dcm: Pixel Data holds 64 bytes"), std::string::npos) << msg;
+}
+
+TEST(IoDicomFolder, SlicesAreOrderedByPositionNotByName) {
+    ScratchDir dir;
+    const Volume v = test::pattern_volume({8, 8, 4}, VoxelType::Int16);
+    write_volume(dir.file("s") + "/", v);
+    // Names that sort against the positions.
+    for (int k = 0; k < 4; ++k)
+        fs::rename(dir.file("s/slice_0000" + std::to_string(k) + ".dcm"),
+                   dir.file("s/" + std::string(1, char('d' - k)) + ".dcm"));
+    const Volume back = read_volume(dir.file("s"));
+    EXPECT_TRUE(test::same_voxels(back, v));
+    EXPECT_NEAR(back.spacing.z, v.spacing.z, 1e-6);
+}
+
+}  // namespace
+}  // namespace lacuna
