@@ -27,16 +27,21 @@ void run(const VolumeArgs& args) {
     std::printf("vis range:   %g .. %g\n", vr.min, vr.max);
 
     // 16-bin histogram over the data range, plus the share of voxels at the minimum (background).
+    // In double, as the viewer's histogram: voxels are finite (Volume::compute_range) and the
+    // width of two floats always fits a double, so u is finite and the clamp gives a bin for
+    // every voxel, however narrow (scl_slope 1e-40) or wide (+-3e38) the data.
     constexpr int kBins = 16;
     std::vector<uint64_t> hist(kBins, 0);
     uint64_t at_min = 0;
-    const float scale = r.max > r.min ? float(kBins) / (r.max - r.min) : 0.f;
+    const double width = double(r.max) - double(r.min);
+    const double scale = width > 0 ? double(kBins) / width : 0.0;
     visit_voxels(v, [&](const auto* p) {
         const size_t n = v.voxel_count();
         for (size_t i = 0; i < n; ++i) {
             const float x = float(p[i]);
             at_min += x == r.min;
-            hist[std::min(kBins - 1, int((x - r.min) * scale))]++;
+            const double u = (double(x) - double(r.min)) * scale;
+            hist[size_t(u < 0 ? 0 : (u >= kBins ? kBins - 1 : int(u)))]++;
         }
     });
     const double n = double(v.voxel_count());
@@ -44,7 +49,7 @@ void run(const VolumeArgs& args) {
     std::printf("histogram:   (%d bins over the value range, %% of voxels)\n", kBins);
     const uint64_t peak = *std::max_element(hist.begin(), hist.end());
     for (int b = 0; b < kBins; ++b) {
-        const float lo = r.min + (r.max - r.min) * float(b) / kBins;
+        const double lo = double(r.min) + width * double(b) / kBins;
         const int bar = peak ? int(40.0 * double(hist[b]) / double(peak) + 0.5) : 0;
         std::printf("  %10.4g  %5.1f%%  %s\n", lo, 100.0 * double(hist[b]) / n,
                     std::string(size_t(bar), '#').c_str());

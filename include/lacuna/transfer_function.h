@@ -7,9 +7,23 @@
 //     idx = clamp(int(u + 0.5), 0, size-1)
 // The map is monotone in v, so every sample whose value lies in [lo, hi] reads an entry in
 // [idx(lo), idx(hi)]: that is what makes per-cell value ranges sufficient for exact skipping.
+//
+// The map is total: every sample gets an entry in [0, size-1], never NaN and never int(NaN).
+// The argument, which keeps the per-sample code at a subtract, a multiply, an add and a clamp:
+//   1. samples are finite: Volume::compute_range rejects NaN/Inf float voxels and float data
+//      whose max - min overflows float, so no lerp of two voxels meets inf - inf or 0 * inf;
+//   2. offset() is finite and scale() is finite and > 0 for ANY range and size (the
+//      constructor below; ranges the boundaries let through always give the exact formula);
+//   3. so (v - offset) * scale + 0.5 is finite or +-inf (an overflow), never NaN, and the clamp
+//      puts +-inf at the ends. Every kernel evaluates the same three operations and clamp.
+// The boundaries (discretise(), Volume::set_vis_range, the TF JSON "range") reject the ranges
+// whose scale float cannot hold (check_lut_range) with one line naming the range.
 #pragma once
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <iosfwd>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,11 +79,32 @@ struct Rgba {
 };
 std::string to_string(const Rgba& c);
 
+// Ranges the map resolves with its exact formula: finite min < max and a finite scale
+// (size-1)/(max-min), i.e. a width of at least (size-1)/FLT_MAX (~3e-36 for 1024 entries).
+// Widths beyond FLT_MAX (e.g. [-3e38, 3e38]) are fine: the scale is taken from the exact width.
+bool lut_range_ok(ValueRange vis, int size = kDefaultLutSize);
+// Throws lacuna::Error(where, field, ...) naming the range and the narrowest width when
+// !lut_range_ok(vis, size).
+void check_lut_range(ValueRange vis, int size, const std::string& where, const std::string& field);
+
 class ValueToLut {
 public:
     ValueToLut() = default;
+    // For a range with lut_range_ok: the exact map, bit for bit the formula in the header
+    // comment. Otherwise (a range no boundary accepts) still total and monotone: a non-finite
+    // min reads as 0, and a scale float cannot hold becomes FLT_MAX (a step at min, the limit
+    // of an ever narrower range).
     ValueToLut(ValueRange vis, int size)
-        : m_min(vis.min), m_scale(float(size - 1) / (vis.max - vis.min)), m_last(size - 1) {}
+        : m_min(std::isfinite(vis.min) ? vis.min : 0.f), m_last(size > 1 ? size - 1 : 0) {
+        float s = float(m_last) / (vis.max - vis.min);
+        // A finite range wider than float (max - min overflowed): the width in double.
+        if (std::isinf(vis.max - vis.min) && std::isfinite(vis.min) && std::isfinite(vis.max))
+            s = std::max(float(double(m_last) / (double(vis.max) - double(vis.min))),
+                         std::numeric_limits<float>::min());
+        m_scale = s > 0.f && s <= std::numeric_limits<float>::max()
+                      ? s
+                      : std::numeric_limits<float>::max();
+    }
     int operator()(float v) const {
         float u = (v - m_min) * m_scale + 0.5f;
         u = u < 0.f ? 0.f : (u > float(m_last) ? float(m_last) : u);

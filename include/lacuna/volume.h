@@ -76,12 +76,15 @@ public:
     Vec3d origin{0, 0, 0};   // world position of voxel (0,0,0), as stored in the file
     double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major direction cosines
 
-    // Scans the voxels: sets data_range (and vis_range if it was never set). For float32,
-    // throws lacuna::Error(where, "voxel (i,j,k)", "NaN/Inf") on the first non-finite voxel.
+    // Scans the voxels: sets data_range (and vis_range if it was never set: the data range, or
+    // [min, min+1] when that is empty or too narrow for the LUT, see lut_range_ok). For float32,
+    // throws lacuna::Error(where, "voxel (i,j,k)", "NaN/Inf") on the first non-finite voxel and
+    // lacuna::Error(where, "voxel values", ...) when max - min overflows float.
     void compute_range(const std::string& where = "volume");
     ValueRange data_range() const { return m_data_range; }
     ValueRange vis_range() const { return m_vis_range; }
-    // Overrides the visualization range; throws lacuna::Error if min >= max or not finite.
+    // Overrides the visualization range; throws lacuna::Error if min >= max, not finite, or too
+    // narrow for the LUT's float scale (check_lut_range).
     void set_vis_range(ValueRange r);
 
     // Physical extent of the sampled region [0, dims-1] * spacing (world units).

@@ -2,6 +2,8 @@
 #include "lacuna/transfer_function.h"
 
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <ostream>
 
 #include "lacuna/error.h"
@@ -71,16 +73,35 @@ void validate_points(const std::vector<P>& pts, TfDomain domain, const std::stri
 void validate(const TransferFunction& tf, const std::string& where) {
     validate_points(tf.color, tf.domain, where, "color", "[x, r, g, b] with r, g, b in [0,1]");
     validate_points(tf.opacity, tf.domain, where, "opacity", "[x, a] with a in [0,1]");
-    if (tf.range) {
-        const ValueRange r = *tf.range;
-        if (!(std::isfinite(r.min) && std::isfinite(r.max) && r.min < r.max))
-            throw Error(where, "range",
-                        "expected [min, max] with finite min < max, got [" + float_text(r.min) +
-                            ", " + float_text(r.max) + "]");
-    }
+    if (tf.range) check_lut_range(*tf.range, kDefaultLutSize, where, "range");
 }
 
 }  // namespace tf_detail
+
+bool lut_range_ok(ValueRange vis, int size) {
+    if (size < 2 || !(std::isfinite(vis.min) && std::isfinite(vis.max) && vis.min < vis.max))
+        return false;
+    // max - min overflowing is fine (ValueToLut takes the width in double then); a scale
+    // beyond float is not.
+    const float w = vis.max - vis.min;
+    return std::isinf(w) || std::isfinite(float(size - 1) / w);
+}
+
+void check_lut_range(ValueRange vis, int size, const std::string& where, const std::string& field) {
+    using tf_detail::float_text;
+    if (lut_range_ok(vis, size)) return;
+    const std::string got = "[" + float_text(vis.min) + ", " + float_text(vis.max) + "]";
+    if (!(std::isfinite(vis.min) && std::isfinite(vis.max) && vis.min < vis.max))
+        throw Error(where, field, "expected [min, max] with finite min < max, got " + got);
+    // The narrowest width whose scale (size-1)/width float holds.
+    char narrowest[32];
+    std::snprintf(narrowest, sizeof(narrowest), "%.3g",
+                  double(size - 1) / double(std::numeric_limits<float>::max()));
+    throw Error(where, field,
+                "expected a range at least " + std::string(narrowest) +
+                    " wide (narrower ones overflow the " + std::to_string(size) +
+                    "-entry LUT's float scale), got " + got);
+}
 
 namespace {
 
@@ -174,10 +195,7 @@ TransferLut discretise(const TransferFunction& tf, ValueRange vis, int size) {
         throw Error(where, "lut size", "expected at least 2 entries, got " + std::to_string(size));
     tf_detail::validate(tf, where);
     if (tf.range) vis = *tf.range;
-    if (!(std::isfinite(vis.min) && std::isfinite(vis.max) && vis.min < vis.max))
-        throw Error(where, "visualization range",
-                    "expected finite min < max, got [" + float_text(vis.min) + ", " +
-                        float_text(vis.max) + "]");
+    check_lut_range(vis, size, where, "visualization range");
 
     TransferLut lut;
     lut.vis = vis;

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include <new>
 
 #include "lacuna/error.h"
+#include "lacuna/transfer_function.h"
 
 namespace lacuna {
 
@@ -130,19 +132,29 @@ void Volume::compute_range(const std::string& where) {
             hi = float(b);
         }
     });
+    // Float voxels spread wider than float (e.g. -3e38 and 3e38): a trilinear lerp of two of
+    // them computes b - a = inf and then inf * 0 or inf - inf, a NaN sample. Rejected, like
+    // non-finite voxels (the totality argument of ValueToLut, transfer_function.h).
+    if (!std::isfinite(hi - lo))
+        throw Error(where, "voxel values",
+                    "expected max - min within float (3.4e38), got " + std::to_string(lo) +
+                        " .. " + std::to_string(hi));
     m_data_range = {lo, hi};
     if (!m_vis_set) {
         m_vis_range = m_data_range;
-        // A constant volume still needs a non-empty range for the TF mapping.
-        if (!(m_vis_range.max > m_vis_range.min)) m_vis_range.max = m_vis_range.min + 1.f;
+        // A constant volume, or one narrower than the LUT's float scale resolves (values within
+        // ~3e-36 of each other, e.g. a NIfTI scl_slope of 1e-40), still needs a usable range:
+        // [min, min + 1], or one step of float wider where min + 1 rounds to min.
+        if (!lut_range_ok(m_vis_range)) {
+            constexpr float inf = std::numeric_limits<float>::infinity();
+            m_vis_range.max = std::max(lo + 1.f, std::nextafter(lo, inf));
+            if (!std::isfinite(m_vis_range.max)) m_vis_range = {std::nextafter(lo, -inf), lo};
+        }
     }
 }
 
 void Volume::set_vis_range(ValueRange r) {
-    if (!std::isfinite(r.min) || !std::isfinite(r.max) || !(r.min < r.max))
-        throw Error("--range", "visualization range",
-                    "expected finite min < max, got " + std::to_string(r.min) + ".." +
-                        std::to_string(r.max));
+    check_lut_range(r, kDefaultLutSize, "--range", "visualization range");
     m_vis_range = r;
     m_vis_set = true;
 }
