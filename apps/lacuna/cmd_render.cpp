@@ -39,6 +39,7 @@ struct RenderArgs {
     bool ortho = false;
     bool azimuth_given = false, elevation_given = false;
     float step = 0.5f, ert = 0.99f;
+    std::string interpolation = "trilinear";
     int threads = 0;
     int leaf = 8, bits = 64, initial_level = -1;
     bool top_down = false;
@@ -110,6 +111,8 @@ Setup validate(RenderArgs& a) {
     if (!(a.ert > 0.f && a.ert <= 1.f)) throw Error("--ert", "threshold", "expected 0 < ert <= 1");
     if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
     s.ro.step = a.step;
+    s.ro.interpolation = parse_interpolation(a.interpolation);
+    s.ao.interpolation = s.ro.interpolation;
     s.ro.ert = a.ert >= 1.f ? 2.f : a.ert;  // 1 means off: opacity never reaches 2
     s.ro.threads = a.threads;
     s.ro.background = parse_rgb(a.background);
@@ -242,6 +245,8 @@ void run(RenderArgs& a) {
         else if (a.slice.renderer == "slice") a.accel = "none";
     }
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
+    if (s.ro.interpolation == Interpolation::Nearest && (a.segments.active() || a.slice.renderer == "slice"))
+        throw Error("--interpolation", "nearest", "supported by the ray marcher only (not with --labels/--segments or --renderer slice)");
     // Shading, lights, clipping, blend modes and jitter live in the ray marcher's feature kernel.
     if (s.ro.features.any() || !a.features.tf_back.empty()) {
         if (a.segments.active())
@@ -305,6 +310,10 @@ void register_render(CLI::App& app) {
     cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
     cmd->add_flag("--ortho", a->ortho, "Orthographic projection");
     cmd->add_option("--step", a->step, "Sample distance in units of the smallest voxel spacing")
+        ->capture_default_str();
+    cmd->add_option("--interpolation", a->interpolation,
+                    "Sampling between voxels: trilinear, or nearest (the voxel a sample falls in; "
+                    "bitfield then skips value sets with holes)")
         ->capture_default_str();
     cmd->add_option("--ert", a->ert, "Early ray termination opacity (1 turns it off)")
         ->capture_default_str();

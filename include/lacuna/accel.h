@@ -43,7 +43,25 @@ std::vector<std::string> accel_names();
 // Every kind, None first: what the conformance tests and benchmarks iterate over.
 std::vector<AccelKind> all_accel_kinds();
 
+// How the renderers sample the volume between voxels (`--interpolation`).
+//   Trilinear  the default: a sample in cell c lies between the min and max of c's 8 corners, so a
+//              structure may only skip a cell whose whole corner *range* of LUT entries is
+//              transparent (neighbouring cells share corners, so value sets never have holes).
+//   Nearest    a sample at index point p takes the voxel floor(p + 0.5) (per axis, in float,
+//              clamped into the box): one of the 8 corners of p's cell. A cell's samples then read
+//              only its corner *values*, so a structure built for Nearest may skip a cell whose
+//              corner values all map to transparent entries even when values between them are
+//              visible: the bitfield paper's sets with holes. A structure built for Trilinear is
+//              exact for both; one built for Nearest only for Nearest (the renderers check).
+enum class Interpolation { Trilinear, Nearest };
+std::string to_string(Interpolation i);
+// Throws lacuna::Error("--interpolation", ...) for a name other than "trilinear" or "nearest".
+Interpolation parse_interpolation(const std::string& name);
+
 struct AccelOptions {
+    // The sampling the structure must be exact for (see Interpolation); only the bitfield octree
+    // builds differently for Nearest, every other structure is exact for both as built.
+    Interpolation interpolation = Interpolation::Trilinear;
     int leaf_cells = 8;        // octree leaf edge in cells (2..64, power of two)
     int bitfield_bits = 64;    // bitfield width: 8, 16, 32, 64 or 128
     int initial_level = -1;    // octree level traversal starts at (-1 = the root)
@@ -74,11 +92,14 @@ public:
     // Must be called before rendering and whenever the TF changes.
     virtual void set_transfer_function(const TransferLut& lut) = 0;
     const AccelStats& stats() const { return m_stats; }
+    // The sampling this structure is exact for: Trilinear (then also Nearest) or Nearest only.
+    Interpolation interpolation() const { return m_interpolation; }
 
 protected:
     explicit Accel(AccelKind k) : m_kind(k) {}
     AccelKind m_kind;
     AccelStats m_stats;
+    Interpolation m_interpolation = Interpolation::Trilinear;
 };
 
 // Builds the structure of kind `k` over `volume` (which must outlive it). For None returns a

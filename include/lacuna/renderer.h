@@ -131,6 +131,9 @@ void validate_features(const FeatureOptions& f);
 
 struct RenderOptions {
     float step = 0.5f;        // sample distance in units of the smallest voxel spacing
+    // Trilinear (default) or nearest-neighbour samples (lacuna/accel.h). A structure built for
+    // Nearest is rejected with Trilinear (its sets with holes would not be exact).
+    Interpolation interpolation = Interpolation::Trilinear;
     float ert = 0.99f;        // early ray termination opacity; >= 1 turns it off
     int threads = 0;          // 0 = all hardware threads
     Vec3f background{0, 0, 0};
@@ -142,7 +145,7 @@ struct RenderOptions {
 
 struct RenderStats {
     double seconds = 0;
-    uint64_t samples = 0;   // trilinear samples taken
+    uint64_t samples = 0;   // samples taken
     uint64_t rays = 0;      // rays that hit the volume's box
     uint64_t pixels = 0;
     uint64_t shadow_samples = 0;        // samples of shadow rays and light-volume rays

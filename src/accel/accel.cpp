@@ -36,6 +36,17 @@ std::vector<AccelKind> all_accel_kinds() {
     return out;
 }
 
+std::string to_string(Interpolation i) {
+    return i == Interpolation::Nearest ? "nearest" : "trilinear";
+}
+
+Interpolation parse_interpolation(const std::string& name) {
+    if (name == "trilinear") return Interpolation::Trilinear;
+    if (name == "nearest") return Interpolation::Nearest;
+    throw Error("--interpolation", "sampling",
+                "unknown '" + name + "'; expected one of: trilinear, nearest");
+}
+
 AccelKind default_accel() { return AccelKind::Grid; }
 
 AccelKind parse_accel(const std::string& name) {

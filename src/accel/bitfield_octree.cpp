@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "core/parallel.h"
+
 namespace lacuna {
 
 namespace {
@@ -22,13 +24,47 @@ BitfieldOctree::BitfieldOctree(const Volume& v, const AccelOptions& o)
         throw Error("--bits", "bitfield width", "expected 8, 16, 32, 64 or 128, got " + std::to_string(b));
     m_nbits = b;
     m_words = b > 64 ? 2 : 1;
+    m_interpolation = o.interpolation;
     build();
 }
 
-void BitfieldOctree::build() {
-    const auto t0 = std::chrono::steady_clock::now();
+// Nearest sampling: a sample in cell c reads one of c's 8 corner voxels, so a leaf's bitfield is
+// the set of bins of the voxels its cells touch, voxels [B*x, B*x + B] per axis (clipped), with
+// holes: two voxels in bins 2 and 9 set bits 2 and 9 only. Values are mapped as the kernels map
+// a nearest sample (ValueToLut of the voxel value itself: no widening, no interpolation).
+void BitfieldOctree::build_nearest_leaves() {
+    const int W = m_words, L = m_pyr.leaf_log2, B = 1 << L;
+    const Vec3i d = m_volume.dims();
+    const int* nl = m_pyr.n[0];
+    visit_voxels(m_volume, [&](const auto* data) {
+        parallel_for(size_t(nl[2]), m_opts.threads, [&](size_t z0, size_t z1) {
+            std::vector<int> bins(size_t(d.x));
+            for (int lz = int(z0); lz < int(z1); ++lz)
+                for (int ly = 0; ly < nl[1]; ++ly) {
+                    uint64_t* row = &m_bits[m_pyr.index(0, 0, ly, lz) * size_t(W)];
+                    const int k1 = std::min((lz + 1) << L, d.z - 1), j1 = std::min((ly + 1) << L, d.y - 1);
+                    for (int k = lz << L; k <= k1; ++k)
+                        for (int j = ly << L; j <= j1; ++j) {
+                            const auto* v = data + (size_t(k) * size_t(d.y) + size_t(j)) * size_t(d.x);
+                            for (int i = 0; i < d.x; ++i) bins[size_t(i)] = bin(m_map(float(v[i])));
+                            // Voxel i is a corner of the cells i - 1 and i: of leaf i / B, and
+                            // of leaf i / B - 1 when it starts that leaf.
+                            for (int i = 0; i < d.x; ++i) {
+                                const int b = bins[size_t(i)], lx = std::min(i >> L, nl[0] - 1);
+                                const uint64_t bit = uint64_t(1) << (b & 63);
+                                row[size_t(lx) * size_t(W) + size_t(b >> 6)] |= bit;
+                                if ((i & (B - 1)) == 0 && lx > 0 && (i >> L) == lx)
+                                    row[size_t(lx - 1) * size_t(W) + size_t(b >> 6)] |= bit;
+                            }
+                        }
+                }
+        });
+    });
+}
+
+// Trilinear sampling: each cell sets the bins of its whole corner range.
+void BitfieldOctree::build_range_leaves() {
     const int W = m_words;
-    m_bits.assign(m_pyr.node_count() * size_t(W), 0);
     // Per LUT entry its bin; per bin b the mask of bits below b (so bits [b0, b1] of a word are
     // below[b1 + 1] ^ below[b0]), for each word.
     std::vector<uint8_t> bin_of(static_cast<size_t>(m_lut_size));
@@ -60,6 +96,16 @@ void BitfieldOctree::build() {
             }
         }
     });
+}
+
+void BitfieldOctree::build() {
+    const auto t0 = std::chrono::steady_clock::now();
+    const int W = m_words;
+    m_bits.assign(m_pyr.node_count() * size_t(W), 0);
+    if (m_interpolation == Interpolation::Nearest)
+        build_nearest_leaves();
+    else
+        build_range_leaves();
     for (int l = 1; l < m_pyr.levels; ++l)
         for (int z = 0; z < m_pyr.n[l][2]; ++z)
             for (int y = 0; y < m_pyr.n[l][1]; ++y)

@@ -8,6 +8,9 @@
 // of bin b has non-zero opacity. A node is empty when (node AND tf) == 0. A TF change only
 // recomputes the TF bitfield (O(lut size)); the tree is built once per volume.
 //
+// Built for Interpolation::Nearest (AccelOptions), a leaf's bitfield is instead the set of bins of
+// the voxels its cells touch: sets with holes, exact only for nearest sampling.
+//
 // Node layout: `words` uint64 per node (1 for <= 64 bits, 2 for 128), bit b in word b/64.
 #pragma once
 #include <cstdint>
@@ -63,6 +66,8 @@ public:
 
 private:
     void build();
+    void build_range_leaves();
+    void build_nearest_leaves();
     int bin(int entry) const { return int(int64_t(entry) * m_nbits / m_lut_size); }
     int m_nbits = 64, m_words = 1;
     std::vector<uint64_t> m_bits;

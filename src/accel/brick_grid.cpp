@@ -9,6 +9,7 @@
 namespace lacuna {
 
 BrickGrid::BrickGrid(const Volume& v, const AccelOptions& o) : OctreeBase(AccelKind::Grid, v, o) {
+    m_interpolation = o.interpolation;
     m_log2 = m_pyr.leaf_log2;  // Pyramid::init validated the edge (power of two, 2..64)
     for (int a = 0; a < 3; ++a) {
         m_nb[a] = (m_pyr.cells[a] + (1 << m_log2) - 1) >> m_log2;
@@ -41,10 +42,42 @@ void BrickGrid::build() {
                 m_block_lo[w] = std::min(m_block_lo[w], m_lo[w * 64 + b]);
                 m_block_hi[w] = std::max(m_block_hi[w], m_hi[w * 64 + b]);
             }
+    if (m_interpolation == Interpolation::Nearest) build_nearest_bins();
     m_stats.build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     m_stats.nodes = size_t(m_nb[0]) * m_nb[1] * m_nb[2];
-    m_stats.bytes = m_lo.size() * 4 + m_words.size() * 8;
+    m_stats.bytes = m_lo.size() * 4 + m_words.size() * 8 + m_bins.size() * 8;
+}
+
+// Per brick the bins of its apron voxels [B*b - 1, B*b + B + 1] (clipped), each voxel mapped as a
+// nearest sample maps it (ValueToLut of the value itself). A brick's voxels are visited once per
+// brick that holds them (about (B + 3)^3 / B^3 times each), in parallel over brick layers.
+void BrickGrid::build_nearest_bins() {
+    const Vec3i d = m_volume.dims();
+    const int B = 1 << m_log2, size = m_map.size();
+    m_bins.assign(m_lo.size(), 0);
+    visit_voxels(m_volume, [&](const auto* data) {
+        parallel_for(size_t(m_nb[2]), m_opts.threads, [&](size_t z0, size_t z1) {
+            std::vector<uint64_t> row(size_t(d.x));  // per voxel of a row, its bin's bit
+            for (int bz = int(z0); bz < int(z1); ++bz)
+                for (int by = 0; by < m_nb[1]; ++by) {
+                    const int k0 = std::max(B * bz - 1, 0), k1 = std::min(B * bz + B + 1, d.z - 1);
+                    const int j0 = std::max(B * by - 1, 0), j1 = std::min(B * by + B + 1, d.y - 1);
+                    for (int k = k0; k <= k1; ++k)
+                        for (int j = j0; j <= j1; ++j) {
+                            const auto* v = data + (size_t(k) * size_t(d.y) + size_t(j)) * size_t(d.x);
+                            for (int i = 0; i < d.x; ++i)
+                                row[size_t(i)] = uint64_t(1) << (int64_t(m_map(float(v[i]))) * 64 / size);
+                            for (int bx = 0; bx < m_nb[0]; ++bx) {
+                                const int i0 = std::max(B * bx - 1, 0), i1 = std::min(B * bx + B + 1, d.x - 1);
+                                uint64_t m = 0;
+                                for (int i = i0; i <= i1; ++i) m |= row[size_t(i)];
+                                m_bins[slot(bx, by, bz)] |= m;
+                            }
+                        }
+                }
+        });
+    });
 }
 
 // Chebyshev distance transform of the block grid, separable: per x row the distance to the
@@ -110,6 +143,9 @@ void BrickGrid::set_transfer_function(const TransferLut& lut) {
     for (int e = size - 1; e >= 0; --e)
         m_next_visible[size_t(e)] =
             lut.entries[size_t(e)].a > 0.f ? uint16_t(e) : m_next_visible[size_t(e) + 1];
+    m_tf_bins = 0;
+    for (int e = 0; e < size; ++e)
+        if (lut.entries[size_t(e)].a > 0.f) m_tf_bins |= uint64_t(1) << (int64_t(e) * 64 / size);
     // One word per block, 64 branch-free tests; two threads on big grids.
     const size_t n = m_words.size();
     const uint16_t* lo = m_lo.data();
@@ -126,6 +162,10 @@ void BrickGrid::set_transfer_function(const TransferLut& lut) {
             const uint16_t* l = lo + w * 64;
             const uint16_t* h = hi + w * 64;
             for (int b = 0; b < 64; ++b) bits |= uint64_t(next[l[b]] <= h[b]) << b;
+            if (!m_bins.empty()) {
+                const uint64_t* bins = m_bins.data() + w * 64;
+                for (int b = 0; b < 64; ++b) bits &= ~(uint64_t((bins[b] & m_tf_bins) == 0) << b);
+            }
             m_words[w] = bits;
         }
     };

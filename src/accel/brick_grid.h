@@ -16,6 +16,14 @@
 // (Deakin & Knackstedt's distance maps, on the block grid: a few thousand entries, so the map is
 // recomputed with every TF in microseconds).
 //
+// Nearest sampling (AccelOptions::interpolation). A sample reads the voxel floor(p + 0.5); at
+// any t the walk attributes to brick b, p lies within less than a voxel of b's box, so that voxel
+// is one of the apron's voxels [B*b - 1, B*b + B + 1]. Built for Nearest, a brick also keeps the
+// set of 64 LUT-entry bins those voxels fall in (bin = entry * 64 / lut size), and is occupied
+// only if its range holds a visible entry *and* one of its bins holds one: value sets with holes,
+// as in the bitfield paper, so an edge between dark and bright tissue skips a visible band of
+// values in between.
+//
 // Exactness argument. Samples are skipped only in stretches of the ray that the DDA attributes to
 // empty bricks, minus the outward rounding of for_each_lattice_run (every skipped sample lies more
 // than one sample spacing inside such a stretch). The DDA computes every plane crossing directly
@@ -55,6 +63,10 @@ public:
     static int bit(int x, int y, int z) { return (x & 3) | (y & 3) << 2 | (z & 3) << 4; }
     // Brick (x, y, z)'s apron-inclusive LUT-entry range (tests).
     void brick_range(int x, int y, int z, int& lo, int& hi) const;
+    // Built for Nearest: the bins (entry * 64 / lut size) of its apron voxels; else all (tests).
+    uint64_t brick_bins(int x, int y, int z) const {
+        return m_bins.empty() ? ~uint64_t(0) : m_bins[slot(x, y, z)];
+    }
 
     // The generic Region answer for the brick holding `cell` (RegionCursor users, MIP windows).
     Region region(const int cell[3], int&) const {
@@ -94,6 +106,11 @@ private:
     std::vector<uint16_t> m_block_lo, m_block_hi;  // per block: union of its bricks' ranges
     std::vector<uint8_t> m_dist;  // per block: Chebyshev distance to an occupied block, 1..255
     std::vector<uint16_t> m_next_visible;  // per LUT entry: the first visible entry >= it
+    // Built for Interpolation::Nearest: per brick (slot order) the set of 64 LUT-entry bins of its
+    // apron voxels, and the bins of the TF's visible entries (see build_nearest_bins).
+    std::vector<uint64_t> m_bins;
+    uint64_t m_tf_bins = 0;
+    void build_nearest_bins();
 };
 
 // Front-to-back walk of one ray through the grid; hands out the stretches that may hold visible

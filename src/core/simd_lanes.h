@@ -86,6 +86,14 @@ struct RayBatch8 {
 
 #if LACUNA_SIMD_X86
 
+// Nearest sampling (kNearest, lacuna/accel.h Interpolation): each lane reads the one voxel
+// floor(p + 0.5) of its clamped position p, kernel::nearest()'s operations; the loads go through a
+// small table (exact int -> float conversions, as float(v) in the scalar path).
+template <class T, int W>
+inline void nearest_values(const T* data, const int32_t* ofs, float* v) {
+    for (int l = 0; l < W; ++l) v[l] = float(data[ofs[l]]);
+}
+
 // ---- SSE4.1: four lanes (the baseline) -------------------------------------------------------
 #if defined(__SSE4_1__)
 // Marches the active lanes. When some need the scheduler (their run ended: k == kend, or they
@@ -93,7 +101,7 @@ struct RayBatch8 {
 // those lanes and returns whether any lane is still active, and marching resumes with the
 // state reloaded. `lut` holds RGBA entries (premultiplied, step-corrected), entry zero_entry all
 // zero. The same contract for every width below.
-template <class T, class Refill>
+template <bool kNearest, class T, class Refill>
 inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                          Refill& refill) {
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.f);
@@ -123,99 +131,117 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
         const __m128i valid = _mm_cmplt_epi32(k, kend);
         // 1. Positions t_k = t_base + (k + 0.5) * dt; cells, fractions, offsets.
         const __m128 t = _mm_add_ps(tb, _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(k), half), vdt));
-        __m128 f[3];
-        __m128i c[3];
-        for (int a = 0; a < 3; ++a) {
-            __m128 x = _mm_add_ps(o[a], _mm_mul_ps(t, d[a]));
-            x = _mm_max_ps(zero, _mm_min_ps(vhi[a], x));
-            c[a] = _mm_min_epi32(_mm_cvttps_epi32(x), vcell[a]);
-            f[a] = _mm_sub_ps(x, _mm_cvtepi32_ps(c[a]));
+        __m128 v;
+        if constexpr (kNearest) {
+            __m128i c[3];
+            for (int a = 0; a < 3; ++a) {
+                __m128 x = _mm_add_ps(o[a], _mm_mul_ps(t, d[a]));
+                x = _mm_max_ps(zero, _mm_min_ps(vhi[a], x));
+                c[a] = _mm_cvttps_epi32(_mm_add_ps(x, half));
+            }
+            const __m128i off = _mm_and_si128(
+                _mm_add_epi32(_mm_add_epi32(_mm_mullo_epi32(c[2], vsz), _mm_mullo_epi32(c[1], vsy)), c[0]),
+                active);
+            alignas(16) int32_t ofs[4];
+            alignas(16) float vals[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(ofs), off);
+            nearest_values<T, 4>(data, ofs, vals);
+            v = _mm_load_ps(vals);
+        } else {
+            __m128 f[3];
+            __m128i c[3];
+            for (int a = 0; a < 3; ++a) {
+                __m128 x = _mm_add_ps(o[a], _mm_mul_ps(t, d[a]));
+                x = _mm_max_ps(zero, _mm_min_ps(vhi[a], x));
+                c[a] = _mm_min_epi32(_mm_cvttps_epi32(x), vcell[a]);
+                f[a] = _mm_sub_ps(x, _mm_cvtepi32_ps(c[a]));
+            }
+            __m128i off = _mm_add_epi32(
+                _mm_add_epi32(_mm_mullo_epi32(c[2], vsz), _mm_mullo_epi32(c[1], vsy)), c[0]);
+            // Idle lanes read voxel 0 (their position is garbage); their entry is replaced below.
+            off = _mm_and_si128(off, active);
+            alignas(16) int32_t ofs[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(ofs), off);
+            // 2. Corners as pairs: one 16-bit (uint8), 32-bit (16-bit) or 64-bit (float) load each.
+            __m128 lo[4], hi[4];
+            if constexpr (sizeof(T) == 1) {
+                __m128i v01 = _mm_setzero_si128(), v23 = _mm_setzero_si128();
+                auto pair = [](const T* p) {
+                    uint16_t w;
+                    __builtin_memcpy(&w, p, 2);
+                    return int(w);
+                };
+    #define LACUNA_PAIRS(l)                                        \
+        {                                                          \
+            const T* p = data + ofs[l];                            \
+            v01 = _mm_insert_epi16(v01, pair(p), l);               \
+            v01 = _mm_insert_epi16(v01, pair(p + sy), 4 + l);      \
+            v23 = _mm_insert_epi16(v23, pair(p + sz), l);          \
+            v23 = _mm_insert_epi16(v23, pair(p + syz), 4 + l);     \
         }
-        __m128i off = _mm_add_epi32(
-            _mm_add_epi32(_mm_mullo_epi32(c[2], vsz), _mm_mullo_epi32(c[1], vsy)), c[0]);
-        // Idle lanes read voxel 0 (their position is garbage); their entry is replaced below.
-        off = _mm_and_si128(off, active);
-        alignas(16) int32_t ofs[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(ofs), off);
-        // 2. Corners as pairs: one 16-bit (uint8), 32-bit (16-bit) or 64-bit (float) load each.
-        __m128 lo[4], hi[4];
-        if constexpr (sizeof(T) == 1) {
-            __m128i v01 = _mm_setzero_si128(), v23 = _mm_setzero_si128();
-            auto pair = [](const T* p) {
-                uint16_t w;
-                __builtin_memcpy(&w, p, 2);
-                return int(w);
-            };
-#define LACUNA_PAIRS(l)                                        \
-    {                                                          \
-        const T* p = data + ofs[l];                            \
-        v01 = _mm_insert_epi16(v01, pair(p), l);               \
-        v01 = _mm_insert_epi16(v01, pair(p + sy), 4 + l);      \
-        v23 = _mm_insert_epi16(v23, pair(p + sz), l);          \
-        v23 = _mm_insert_epi16(v23, pair(p + syz), 4 + l);     \
-    }
-            LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
-#undef LACUNA_PAIRS
-            const __m128i m_lo0 = _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
-            const __m128i m_hi0 = _mm_setr_epi8(1, -1, -1, -1, 3, -1, -1, -1, 5, -1, -1, -1, 7, -1, -1, -1);
-            const __m128i m_lo1 = _mm_setr_epi8(8, -1, -1, -1, 10, -1, -1, -1, 12, -1, -1, -1, 14, -1, -1, -1);
-            const __m128i m_hi1 = _mm_setr_epi8(9, -1, -1, -1, 11, -1, -1, -1, 13, -1, -1, -1, 15, -1, -1, -1);
-            lo[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo0));
-            hi[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi0));
-            lo[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo1));
-            hi[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi1));
-            lo[2] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_lo0));
-            hi[2] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_hi0));
-            lo[3] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_lo1));
-            hi[3] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_hi1));
-        } else if constexpr (sizeof(T) == 2) {
-            __m128i v[4] = {_mm_setzero_si128(), _mm_setzero_si128(), _mm_setzero_si128(),
-                            _mm_setzero_si128()};
-            auto pair = [](const T* p) {
-                int32_t w;
-                __builtin_memcpy(&w, p, 4);
-                return w;
-            };
-#define LACUNA_PAIRS(l)                                  \
-    {                                                    \
-        const T* p = data + ofs[l];                      \
-        v[0] = _mm_insert_epi32(v[0], pair(p), l);       \
-        v[1] = _mm_insert_epi32(v[1], pair(p + sy), l);  \
-        v[2] = _mm_insert_epi32(v[2], pair(p + sz), l);  \
-        v[3] = _mm_insert_epi32(v[3], pair(p + syz), l); \
-    }
-            LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
-#undef LACUNA_PAIRS
-            for (int q = 0; q < 4; ++q) {
-                if constexpr (std::is_signed_v<T>) {
-                    lo[q] = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(v[q], 16), 16));
-                    hi[q] = _mm_cvtepi32_ps(_mm_srai_epi32(v[q], 16));
-                } else {
-                    lo[q] = _mm_cvtepi32_ps(_mm_and_si128(v[q], _mm_set1_epi32(0xffff)));
-                    hi[q] = _mm_cvtepi32_ps(_mm_srli_epi32(v[q], 16));
+                LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+    #undef LACUNA_PAIRS
+                const __m128i m_lo0 = _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
+                const __m128i m_hi0 = _mm_setr_epi8(1, -1, -1, -1, 3, -1, -1, -1, 5, -1, -1, -1, 7, -1, -1, -1);
+                const __m128i m_lo1 = _mm_setr_epi8(8, -1, -1, -1, 10, -1, -1, -1, 12, -1, -1, -1, 14, -1, -1, -1);
+                const __m128i m_hi1 = _mm_setr_epi8(9, -1, -1, -1, 11, -1, -1, -1, 13, -1, -1, -1, 15, -1, -1, -1);
+                lo[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo0));
+                hi[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi0));
+                lo[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo1));
+                hi[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi1));
+                lo[2] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_lo0));
+                hi[2] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_hi0));
+                lo[3] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_lo1));
+                hi[3] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v23, m_hi1));
+            } else if constexpr (sizeof(T) == 2) {
+                __m128i v[4] = {_mm_setzero_si128(), _mm_setzero_si128(), _mm_setzero_si128(),
+                                _mm_setzero_si128()};
+                auto pair = [](const T* p) {
+                    int32_t w;
+                    __builtin_memcpy(&w, p, 4);
+                    return w;
+                };
+    #define LACUNA_PAIRS(l)                                  \
+        {                                                    \
+            const T* p = data + ofs[l];                      \
+            v[0] = _mm_insert_epi32(v[0], pair(p), l);       \
+            v[1] = _mm_insert_epi32(v[1], pair(p + sy), l);  \
+            v[2] = _mm_insert_epi32(v[2], pair(p + sz), l);  \
+            v[3] = _mm_insert_epi32(v[3], pair(p + syz), l); \
+        }
+                LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+    #undef LACUNA_PAIRS
+                for (int q = 0; q < 4; ++q) {
+                    if constexpr (std::is_signed_v<T>) {
+                        lo[q] = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(v[q], 16), 16));
+                        hi[q] = _mm_cvtepi32_ps(_mm_srai_epi32(v[q], 16));
+                    } else {
+                        lo[q] = _mm_cvtepi32_ps(_mm_and_si128(v[q], _mm_set1_epi32(0xffff)));
+                        hi[q] = _mm_cvtepi32_ps(_mm_srli_epi32(v[q], 16));
+                    }
+                }
+            } else {
+                const ptrdiff_t step[4] = {0, sy, sz, syz};
+                for (int q = 0; q < 4; ++q) {
+                    const __m64* p0 = reinterpret_cast<const __m64*>(data + ofs[0] + step[q]);
+                    const __m64* p1 = reinterpret_cast<const __m64*>(data + ofs[1] + step[q]);
+                    const __m64* p2 = reinterpret_cast<const __m64*>(data + ofs[2] + step[q]);
+                    const __m64* p3 = reinterpret_cast<const __m64*>(data + ofs[3] + step[q]);
+                    const __m128 x01 = _mm_loadh_pi(_mm_loadl_pi(zero, p0), p1);
+                    const __m128 x23 = _mm_loadh_pi(_mm_loadl_pi(zero, p2), p3);
+                    lo[q] = _mm_shuffle_ps(x01, x23, _MM_SHUFFLE(2, 0, 2, 0));
+                    hi[q] = _mm_shuffle_ps(x01, x23, _MM_SHUFFLE(3, 1, 3, 1));
                 }
             }
-        } else {
-            const ptrdiff_t step[4] = {0, sy, sz, syz};
-            for (int q = 0; q < 4; ++q) {
-                const __m64* p0 = reinterpret_cast<const __m64*>(data + ofs[0] + step[q]);
-                const __m64* p1 = reinterpret_cast<const __m64*>(data + ofs[1] + step[q]);
-                const __m64* p2 = reinterpret_cast<const __m64*>(data + ofs[2] + step[q]);
-                const __m64* p3 = reinterpret_cast<const __m64*>(data + ofs[3] + step[q]);
-                const __m128 x01 = _mm_loadh_pi(_mm_loadl_pi(zero, p0), p1);
-                const __m128 x23 = _mm_loadh_pi(_mm_loadl_pi(zero, p2), p3);
-                lo[q] = _mm_shuffle_ps(x01, x23, _MM_SHUFFLE(2, 0, 2, 0));
-                hi[q] = _mm_shuffle_ps(x01, x23, _MM_SHUFFLE(3, 1, 3, 1));
-            }
+            // 3. Trilinear lerps (trilinear()'s order) and the LUT entry (ValueToLut).
+            auto lerp = [](__m128 a, __m128 b, __m128 w) {
+                return _mm_add_ps(a, _mm_mul_ps(w, _mm_sub_ps(b, a)));
+            };
+            const __m128 c00 = lerp(lo[0], hi[0], f[0]), c10 = lerp(lo[1], hi[1], f[0]);
+            const __m128 c01 = lerp(lo[2], hi[2], f[0]), c11 = lerp(lo[3], hi[3], f[0]);
+            const __m128 c0 = lerp(c00, c10, f[1]), c1 = lerp(c01, c11, f[1]);
+            v = lerp(c0, c1, f[2]);
         }
-        // 3. Trilinear lerps (trilinear()'s order) and the LUT entry (ValueToLut).
-        auto lerp = [](__m128 a, __m128 b, __m128 w) {
-            return _mm_add_ps(a, _mm_mul_ps(w, _mm_sub_ps(b, a)));
-        };
-        const __m128 c00 = lerp(lo[0], hi[0], f[0]), c10 = lerp(lo[1], hi[1], f[0]);
-        const __m128 c01 = lerp(lo[2], hi[2], f[0]), c11 = lerp(lo[3], hi[3], f[0]);
-        const __m128 c0 = lerp(c00, c10, f[1]), c1 = lerp(c01, c11, f[1]);
-        const __m128 v = lerp(c0, c1, f[2]);
         __m128 u = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(v, voff), vscale), half);
         u = _mm_max_ps(zero, _mm_min_ps(vlast, u));
         const __m128i entry = _mm_blendv_epi8(vzero_entry, _mm_cvttps_epi32(u), valid);
@@ -366,8 +392,35 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
     return _mm256_add_ps(c0, _mm256_mul_ps(fz, _mm256_sub_ps(c1, c0)));
 }
 
+// Nearest values at eight index-space points: clamped as trilinear8 clamps, then the voxel
+// floor(p + 0.5) (kernel::nearest()'s operations). Float voxels by one gather, integers by scalar
+// loads into a table.
+template <class T, class G>
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, const T* data,
+                                                                   __m256 x, __m256 y, __m256 z) {
+    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
+    x = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), x));
+    y = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), y));
+    z = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), z));
+    const __m256i ci = _mm256_cvttps_epi32(_mm256_add_ps(x, half));
+    const __m256i cj = _mm256_cvttps_epi32(_mm256_add_ps(y, half));
+    const __m256i ck = _mm256_cvttps_epi32(_mm256_add_ps(z, half));
+    const __m256i off = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                         _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+        ci);
+    if constexpr (std::is_same_v<T, float>) {
+        return _mm256_i32gather_ps(data, off, 4);
+    } else {
+        alignas(32) int32_t o[8];
+        alignas(32) float v[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(o), off);
+        nearest_values<T, 8>(data, o, v);
+        return _mm256_load_ps(v);
+    }
+}
 
-template <class T, class Refill>
+template <bool kNearest, class T, class Refill>
 LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                               Refill& refill) {
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.f);
@@ -398,7 +451,11 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
         __m256 x = _mm256_add_ps(ox, _mm256_mul_ps(t, dx));
         __m256 y = _mm256_add_ps(oy, _mm256_mul_ps(t, dy));
         __m256 z = _mm256_add_ps(oz, _mm256_mul_ps(t, dz));
-        const __m256 v = trilinear8(g, data, x, y, z);
+        __m256 v;
+        if constexpr (kNearest)
+            v = nearest8(g, data, x, y, z);
+        else
+            v = trilinear8(g, data, x, y, z);
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
         const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), valid);
@@ -456,7 +513,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define LACUNA_AVX512 __attribute__((target("avx512f")))
 
-template <class T, class Refill>
+template <bool kNearest, class T, class Refill>
 LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                                 Refill& refill) {
     const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
@@ -499,98 +556,117 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         x = _mm512_max_ps(zero, _mm512_min_ps(vhi0, x));
         y = _mm512_max_ps(zero, _mm512_min_ps(vhi1, y));
         z = _mm512_max_ps(zero, _mm512_min_ps(vhi2, z));
-        const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), vc0);
-        const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), vc1);
-        const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(z), vc2);
-        const __m512 fx = _mm512_sub_ps(x, _mm512_cvtepi32_ps(ci));
-        const __m512 fy = _mm512_sub_ps(y, _mm512_cvtepi32_ps(cj));
-        const __m512 fz = _mm512_sub_ps(z, _mm512_cvtepi32_ps(ck));
-        __m512i off = _mm512_add_epi32(
-            _mm512_add_epi32(_mm512_mullo_epi32(ck, vsz), _mm512_mullo_epi32(cj, vsy)), ci);
-        off = _mm512_maskz_mov_epi32(active, off);  // idle lanes read voxel 0
-        __m512 c000, c100, c010, c110, c001, c101, c011, c111;
-        if constexpr (kByte) {
-            // Corner pairs by 16-bit scalar loads into a table (trilinear8's way; cheaper than
-            // four sixteen-lane gathers here), widened: low byte voxel i, high byte voxel i + 1.
-            alignas(64) int32_t ofs[16];
-            alignas(32) uint16_t wp[4][16];
-            _mm512_store_si512(ofs, off);
-            const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-            for (int l = 0; l < 16; ++l) {
-                const T* p = data + ofs[l];
-                __builtin_memcpy(&wp[0][l], p, 2);
-                __builtin_memcpy(&wp[1][l], p + psy, 2);
-                __builtin_memcpy(&wp[2][l], p + psz, 2);
-                __builtin_memcpy(&wp[3][l], p + psyz, 2);
-            }
-            const __m512i m = _mm512_set1_epi32(0xff);
-            const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
-            const __m512i w1 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
-            const __m512i w2 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[2])));
-            const __m512i w3 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[3])));
-            c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
-            c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 8));
-            c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
-            c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 8));
-            c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
-            c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 8));
-            c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
-            c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 8));
-        } else if constexpr (sizeof(T) == 2) {
-            // 16-bit voxels: each corner pair is one 32-bit scalar load, into a table.
-            alignas(64) int32_t ofs[16];
-            alignas(64) int32_t wq[4][16];
-            _mm512_store_si512(ofs, off);
-            const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-            for (int l = 0; l < 16; ++l) {
-                const T* p = data + ofs[l];
-                __builtin_memcpy(&wq[0][l], p, 4);
-                __builtin_memcpy(&wq[1][l], p + psy, 4);
-                __builtin_memcpy(&wq[2][l], p + psz, 4);
-                __builtin_memcpy(&wq[3][l], p + psyz, 4);
-            }
-            const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
-            const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
-            if constexpr (std::is_signed_v<T>) {
-                c000 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w0, 16), 16));
-                c010 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w1, 16), 16));
-                c001 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w2, 16), 16));
-                c011 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w3, 16), 16));
-                c100 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w0, 16));
-                c110 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w1, 16));
-                c101 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w2, 16));
-                c111 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w3, 16));
+        __m512 v;
+        if constexpr (kNearest) {
+            const __m512i ni = _mm512_cvttps_epi32(_mm512_add_ps(x, half));
+            const __m512i nj = _mm512_cvttps_epi32(_mm512_add_ps(y, half));
+            const __m512i nk = _mm512_cvttps_epi32(_mm512_add_ps(z, half));
+            const __m512i off = _mm512_maskz_mov_epi32(
+                active, _mm512_add_epi32(
+                            _mm512_add_epi32(_mm512_mullo_epi32(nk, vsz), _mm512_mullo_epi32(nj, vsy)), ni));
+            if constexpr (std::is_same_v<T, float>) {
+                v = _mm512_i32gather_ps(off, reinterpret_cast<const float*>(data), 4);
             } else {
-                const __m512i m = _mm512_set1_epi32(0xffff);
-                c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
-                c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
-                c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
-                c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
-                c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 16));
-                c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 16));
-                c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 16));
-                c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 16));
+                alignas(64) int32_t ofs[16];
+                alignas(64) float vals[16];
+                _mm512_store_si512(ofs, off);
+                nearest_values<T, 16>(data, ofs, vals);
+                v = _mm512_load_ps(vals);
             }
         } else {
-            const float* base = reinterpret_cast<const float*>(data);
-            const __m512i o1 = _mm512_add_epi32(off, q1), o2 = _mm512_add_epi32(off, q2),
-                          o3 = _mm512_add_epi32(off, q3);
-            c000 = _mm512_i32gather_ps(off, base, 4);
-            c100 = _mm512_i32gather_ps(off, base + 1, 4);
-            c010 = _mm512_i32gather_ps(o1, base, 4);
-            c110 = _mm512_i32gather_ps(o1, base + 1, 4);
-            c001 = _mm512_i32gather_ps(o2, base, 4);
-            c101 = _mm512_i32gather_ps(o2, base + 1, 4);
-            c011 = _mm512_i32gather_ps(o3, base, 4);
-            c111 = _mm512_i32gather_ps(o3, base + 1, 4);
+            const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), vc0);
+            const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), vc1);
+            const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(z), vc2);
+            const __m512 fx = _mm512_sub_ps(x, _mm512_cvtepi32_ps(ci));
+            const __m512 fy = _mm512_sub_ps(y, _mm512_cvtepi32_ps(cj));
+            const __m512 fz = _mm512_sub_ps(z, _mm512_cvtepi32_ps(ck));
+            __m512i off = _mm512_add_epi32(
+                _mm512_add_epi32(_mm512_mullo_epi32(ck, vsz), _mm512_mullo_epi32(cj, vsy)), ci);
+            off = _mm512_maskz_mov_epi32(active, off);  // idle lanes read voxel 0
+            __m512 c000, c100, c010, c110, c001, c101, c011, c111;
+            if constexpr (kByte) {
+                // Corner pairs by 16-bit scalar loads into a table (trilinear8's way; cheaper than
+                // four sixteen-lane gathers here), widened: low byte voxel i, high byte voxel i + 1.
+                alignas(64) int32_t ofs[16];
+                alignas(32) uint16_t wp[4][16];
+                _mm512_store_si512(ofs, off);
+                const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
+                for (int l = 0; l < 16; ++l) {
+                    const T* p = data + ofs[l];
+                    __builtin_memcpy(&wp[0][l], p, 2);
+                    __builtin_memcpy(&wp[1][l], p + psy, 2);
+                    __builtin_memcpy(&wp[2][l], p + psz, 2);
+                    __builtin_memcpy(&wp[3][l], p + psyz, 2);
+                }
+                const __m512i m = _mm512_set1_epi32(0xff);
+                const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
+                const __m512i w1 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
+                const __m512i w2 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[2])));
+                const __m512i w3 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[3])));
+                c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
+                c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 8));
+                c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
+                c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 8));
+                c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
+                c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 8));
+                c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
+                c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 8));
+            } else if constexpr (sizeof(T) == 2) {
+                // 16-bit voxels: each corner pair is one 32-bit scalar load, into a table.
+                alignas(64) int32_t ofs[16];
+                alignas(64) int32_t wq[4][16];
+                _mm512_store_si512(ofs, off);
+                const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
+                for (int l = 0; l < 16; ++l) {
+                    const T* p = data + ofs[l];
+                    __builtin_memcpy(&wq[0][l], p, 4);
+                    __builtin_memcpy(&wq[1][l], p + psy, 4);
+                    __builtin_memcpy(&wq[2][l], p + psz, 4);
+                    __builtin_memcpy(&wq[3][l], p + psyz, 4);
+                }
+                const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
+                const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
+                if constexpr (std::is_signed_v<T>) {
+                    c000 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w0, 16), 16));
+                    c010 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w1, 16), 16));
+                    c001 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w2, 16), 16));
+                    c011 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w3, 16), 16));
+                    c100 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w0, 16));
+                    c110 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w1, 16));
+                    c101 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w2, 16));
+                    c111 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w3, 16));
+                } else {
+                    const __m512i m = _mm512_set1_epi32(0xffff);
+                    c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
+                    c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
+                    c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
+                    c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
+                    c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 16));
+                    c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 16));
+                    c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 16));
+                    c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 16));
+                }
+            } else {
+                const float* base = reinterpret_cast<const float*>(data);
+                const __m512i o1 = _mm512_add_epi32(off, q1), o2 = _mm512_add_epi32(off, q2),
+                              o3 = _mm512_add_epi32(off, q3);
+                c000 = _mm512_i32gather_ps(off, base, 4);
+                c100 = _mm512_i32gather_ps(off, base + 1, 4);
+                c010 = _mm512_i32gather_ps(o1, base, 4);
+                c110 = _mm512_i32gather_ps(o1, base + 1, 4);
+                c001 = _mm512_i32gather_ps(o2, base, 4);
+                c101 = _mm512_i32gather_ps(o2, base + 1, 4);
+                c011 = _mm512_i32gather_ps(o3, base, 4);
+                c111 = _mm512_i32gather_ps(o3, base + 1, 4);
+            }
+            const __m512 c00 = _mm512_add_ps(c000, _mm512_mul_ps(fx, _mm512_sub_ps(c100, c000)));
+            const __m512 c10 = _mm512_add_ps(c010, _mm512_mul_ps(fx, _mm512_sub_ps(c110, c010)));
+            const __m512 c01 = _mm512_add_ps(c001, _mm512_mul_ps(fx, _mm512_sub_ps(c101, c001)));
+            const __m512 c11 = _mm512_add_ps(c011, _mm512_mul_ps(fx, _mm512_sub_ps(c111, c011)));
+            const __m512 c0 = _mm512_add_ps(c00, _mm512_mul_ps(fy, _mm512_sub_ps(c10, c00)));
+            const __m512 c1 = _mm512_add_ps(c01, _mm512_mul_ps(fy, _mm512_sub_ps(c11, c01)));
+            v = _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
         }
-        const __m512 c00 = _mm512_add_ps(c000, _mm512_mul_ps(fx, _mm512_sub_ps(c100, c000)));
-        const __m512 c10 = _mm512_add_ps(c010, _mm512_mul_ps(fx, _mm512_sub_ps(c110, c010)));
-        const __m512 c01 = _mm512_add_ps(c001, _mm512_mul_ps(fx, _mm512_sub_ps(c101, c001)));
-        const __m512 c11 = _mm512_add_ps(c011, _mm512_mul_ps(fx, _mm512_sub_ps(c111, c011)));
-        const __m512 c0 = _mm512_add_ps(c00, _mm512_mul_ps(fy, _mm512_sub_ps(c10, c00)));
-        const __m512 c1 = _mm512_add_ps(c01, _mm512_mul_ps(fy, _mm512_sub_ps(c11, c01)));
-        const __m512 v = _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
         u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
         const __m512i entry = _mm512_mask_blend_epi32(valid, vzero_entry, _mm512_cvttps_epi32(u));

@@ -73,6 +73,7 @@ struct Context {
     float crop_lo[3] = {}, crop_hi[3] = {};  // index space
     float step = 0.5f, dt = 0, dts = 0, ert = 2.f;
     Vec3f sp{1, 1, 1}, inv_sp{1, 1, 1};
+    bool nearest = false;             // Interpolation::Nearest: value() reads the nearest voxel
     bool need_gradient = false;
     const float* grad[3] = {};        // precomputed world gradient, or null: on the fly
     const float* light = nullptr;     // light volume (transmittance), or null
@@ -104,9 +105,22 @@ inline float jitter(uint32_t x, uint32_t y, uint32_t seed) {
     return float(h >> 8) * (1.f / 16777216.f);
 }
 
-// World-space gradient (voxel values per mm) at index point (x,y,z).
+// The sample value at index point (x,y,z) under the frame's interpolation.
+template <class T, class Index>
+inline float value(const Context& c, const kernel::Grid<T, Index>& g, float x, float y, float z) {
+    return c.nearest ? kernel::nearest(g, x, y, z) : kernel::trilinear(g, x, y, z);
+}
+
+// World-space gradient (voxel values per mm) at index point (x,y,z). Under nearest sampling, the
+// gradient of the voxel the sample reads (the point moved to that voxel: central differences of
+// voxels, as VTK's nearest mode shades with per-voxel normals).
 template <class T, class Index>
 inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x, float y, float z) {
+    if (c.nearest) {
+        x = float(int(std::clamp(x, 0.f, g.hi_x) + 0.5f));
+        y = float(int(std::clamp(y, 0.f, g.hi_y) + 0.5f));
+        z = float(int(std::clamp(z, 0.f, g.hi_z) + 0.5f));
+    }
     if (c.grad[0]) {
         const int m[3] = {int(g.hi_x) + 1, int(g.hi_y) + 1, int(g.hi_z) + 1};
         return {kernel::trilinear(float_grid(c.grad[0], m), x, y, z),
@@ -139,7 +153,7 @@ float transmittance(const Context& c, const kernel::Grid<T, Index>& g, const S& 
         const float qx = r.ox + t * r.dx, qy = r.oy + t * r.dy, qz = r.oz + t * r.dz;
         if (!c.kept(qx, qy, qz)) return true;
         ++n;
-        const float as = c.shadow_corr[c.side(qx, qy, qz)][c.map(kernel::trilinear(g, qx, qy, qz))].a;
+        const float as = c.shadow_corr[c.side(qx, qy, qz)][c.map(value(c, g, qx, qy, qz))].a;
         if (as > 0.f) {
             a += (1.f - a) * as;
             if (a >= c.ert) return false;
@@ -226,7 +240,7 @@ inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g,
         if (!c.kept(x, y, z)) return true;
         // 2. The TF of this side; zero opacity contributes nothing (and may be skipped).
         const int s = c.side(x, y, z);
-        const int e = c.map(kernel::trilinear(g, x, y, z));
+        const int e = c.map(value(c, g, x, y, z));
         ++n;
         const Rgba& raw = c.raw[s][e];
         if (!(raw.a > 0.f)) return true;
@@ -594,7 +608,7 @@ inline uint32_t extreme_ray(const Context& c, const kernel::Grid<T, Index>& g, C
         const float t = t_base + (float(k) + 0.5f) * c.dt;
         const float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
         if (!c.kept(x, y, z)) return true;
-        const int e = c.map(kernel::trilinear(g, x, y, z));
+        const int e = c.map(value(c, g, x, y, z));
         ++n;
         if (maximum ? e > cur : e < cur) {
             cur = e;
@@ -621,7 +635,7 @@ inline uint32_t average_ray(const Context& c, const kernel::Grid<T, Index>& g, C
         const float t = t_base + (float(k) + 0.5f) * c.dt;
         const float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
         if (!c.kept(x, y, z)) return true;
-        const float v = kernel::trilinear(g, x, y, z);
+        const float v = value(c, g, x, y, z);
         ++n;
         if (c.raw[c.side(x, y, z)][c.map(v)].a > 0.f) {
             sum += v;

@@ -134,6 +134,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
     c.inv_sp = {float(1.0 / s.x), float(1.0 / s.y), float(1.0 / s.z)};
     const float min_sp = float(std::min({s.x, s.y, s.z}));
     c.step = opt.step;
+    c.nearest = opt.interpolation == Interpolation::Nearest;
     c.dt = opt.step * min_sp;
     c.dts = f.shadows.step * min_sp;
     c.ert = opt.ert;
@@ -211,7 +212,9 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             // time (feature::composite_ray, the reference; also the scalar ISA path).
             const int dims[3] = {d.x, d.y, d.z};
             const simd::ShadeGrid sg = feature::shade_grid(c, dims);
+            // Nearest sampling runs the reference too (one path for every ISA, so still exact).
             const bool batched = composite && !f.shadows.enabled && !f.gradient_opacity.enabled &&
+                                 !c.nearest &&
                                  m_volume.voxel_count() < (size_t(1) << 31);
             auto frame = [&](auto ops) {
                 using Ops = typename decltype(ops)::type;

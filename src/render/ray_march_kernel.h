@@ -63,6 +63,28 @@ inline float trilinear(const Grid<T, Index>& g, float x, float y, float z) {
     return c0 + fz * (c1 - c0);
 }
 
+// Nearest-neighbour sampling at index-space point (x,y,z): clamped into the box as trilinear()
+// does, then the voxel floor(x + 0.5) per axis, in float (x + 0.5f rounds; int() truncates a
+// non-negative value). Always a corner of the cell trilinear() would use, so every structure's
+// per-cell ranges cover it (lacuna/accel.h, Interpolation).
+template <class T, class Index>
+inline float nearest(const Grid<T, Index>& g, float x, float y, float z) {
+    x = std::clamp(x, 0.f, g.hi_x);
+    y = std::clamp(y, 0.f, g.hi_y);
+    z = std::clamp(z, 0.f, g.hi_z);
+    const int i = int(x + 0.5f), j = int(y + 0.5f), k = int(z + 0.5f);
+    return float(g.data[ptrdiff_t(k) * g.sz + ptrdiff_t(j) * g.sy + i]);
+}
+
+// The value of a sample under either interpolation.
+template <bool kNearest, class T, class Index>
+inline float sample(const Grid<T, Index>& g, float x, float y, float z) {
+    if constexpr (kNearest)
+        return nearest(g, x, y, z);
+    else
+        return trilinear(g, x, y, z);
+}
+
 // Front-to-back accumulation state of one ray (premultiplied colour).
 struct Accum {
     float r = 0, g = 0, b = 0, a = 0;
@@ -113,7 +135,7 @@ inline constexpr int kBatch = 8;
 
 // The one-ray-at-a-time reference path (LACUNA_ISA=scalar, and volumes of 2^31 voxels or more);
 // the SIMD paths run several rays per instruction instead (core/simd_lanes.h).
-template <class T, class Index>
+template <class T, class Index, bool kNearest = false>
 class RayStream {
 public:
     RayStream(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, const Rgba* lut,
@@ -179,6 +201,20 @@ private:
     LACUNA_ALWAYS_INLINE void lut_entries(int* entry) const {
         const Grid<T, Index>& g = m_g;
         const IndexRay& r = m_r;
+        if constexpr (kNearest) {
+            // nearest()'s operations: position, clamp, the voxel floor(p + 0.5).
+            for (int l = 0; l < kBatch; ++l) {
+                const float t = m_t_base + (float(m_k[l]) + 0.5f) * m_dt;
+                float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
+                x = x < 0.f ? 0.f : (x > g.hi_x ? g.hi_x : x);
+                y = y < 0.f ? 0.f : (y > g.hi_y ? g.hi_y : y);
+                z = z < 0.f ? 0.f : (z > g.hi_z ? g.hi_z : z);
+                const Index off = Index(int(z + 0.5f)) * Index(g.sz) +
+                                  Index(int(y + 0.5f)) * Index(g.sy) + Index(int(x + 0.5f));
+                entry[l] = m_map(float(g.data[off]));
+            }
+            return;
+        }
         float fx[kBatch], fy[kBatch], fz[kBatch];
         Index off[kBatch];
         // 1. Lattice positions, clamped into the box; cell index and fractions.
@@ -241,10 +277,10 @@ private:
 
 // Marches the samples k in [k0, k1) on their own (one run of a stream). Returns the number of
 // samples taken; sets `done` once opacity reaches `ert`.
-template <class T, class Index>
+template <class T, class Index, bool kNearest = false>
 inline uint32_t march(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, int k0,
                       int k1, const Rgba* lut, ValueToLut map, float ert, Accum& acc, bool& done) {
-    RayStream<T, Index> s(g, r, t_base, dt, lut, map, ert, acc);
+    RayStream<T, Index, kNearest> s(g, r, t_base, dt, lut, map, ert, acc);
     s.add(k0, k1);
     s.finish();
     done = done || s.done();

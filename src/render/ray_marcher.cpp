@@ -89,7 +89,7 @@ Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; 
 
 namespace {
 
-template <class T, class Index, class S>
+template <class T, class Index, bool kNearest, class S>
 void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
                  const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
                  RenderResult& out, std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
@@ -108,7 +108,7 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
                 ++tile_rays;
                 typename S::Cursor cursor(accel, cursor_ray(r), t_near, t_far, dt,
                                           opt.ert < 1.f ? kCursorChunk * dt : 0.f);
-                kernel::RayStream<T, Index> stream(g, r, t_near, dt, lut.data(), map, opt.ert,
+                kernel::RayStream<T, Index, kNearest> stream(g, r, t_near, dt, lut.data(), map, opt.ert,
                                                    acc);
                 for_each_lattice_run(cursor, t_near, dt, lattice_end(t_near, t_far, dt),
                                      [&](int kb, int ke) { return stream.add(kb, ke); });
@@ -258,13 +258,13 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
 
 // One tile on the active kernel path (simd::active_isa()); volumes of 2^31 voxels or more, and
 // the scalar path, march one ray at a time.
-template <class T, class S>
+template <class T, bool kNearest, class S>
 void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol, const T* data,
                     const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
                     ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
                     std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
     if (!small || (x1 - x0) * (y1 - y0) > kMaxTilePixels) {
-        render_tile<T, int64_t>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+        render_tile<T, int64_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                 samples, rays);
         return;
     }
@@ -273,23 +273,23 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
         case simd::Isa::Avx512:
             render_tile_lanes<16>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                   samples, rays,
-                                  [](auto&&... a) { simd::march_lanes16<T>(a...); });
+                                  [](auto&&... a) { simd::march_lanes16<kNearest, T>(a...); });
             return;
         case simd::Isa::Avx2:
             render_tile_lanes<8>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                  samples, rays,
-                                  [](auto&&... a) { simd::march_lanes8<T>(a...); });
+                                  [](auto&&... a) { simd::march_lanes8<kNearest, T>(a...); });
             return;
 #if defined(__SSE4_1__)
         case simd::Isa::Sse41:
             render_tile_lanes<4>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                  samples, rays,
-                                  [](auto&&... a) { simd::march_lanes4<T>(a...); });
+                                  [](auto&&... a) { simd::march_lanes4<kNearest, T>(a...); });
             return;
 #endif
 #endif
         default:
-            render_tile<T, int32_t>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+            render_tile<T, int32_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                     samples, rays);
     }
 }
@@ -302,6 +302,10 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
         throw Error("--step", "step", "expected a positive number");
     if (cam.width() < 1 || cam.height() < 1)
         throw Error("--size", "image size", "expected at least 1x1 pixels");
+    if (m_accel && m_accel->interpolation() == Interpolation::Nearest &&
+        opt.interpolation != Interpolation::Nearest)
+        throw Error("--interpolation", "sampling",
+                    "the structure was built for nearest sampling; expected --interpolation nearest");
     if (opt.features.any()) return render_features(cam, opt);
     RenderResult out;
     out.image = Image(cam.width(), cam.height());
@@ -318,11 +322,18 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
         const bool small = m_volume.voxel_count() < (size_t(1) << 31);
         static const NoAccel kNone;
         visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
-            parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
-                               [&](int x0, int y0, int x1, int y1) {
-                                   render_tile_on<T>(isa, small, s, m_volume, data, cam, opt, lut,
-                                                     map, x0, y0, x1, y1, out, samples, rays);
-                               });
+            auto frame = [&](auto nearest) {
+                parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                                   [&](int x0, int y0, int x1, int y1) {
+                                       render_tile_on<T, decltype(nearest)::value>(
+                                           isa, small, s, m_volume, data, cam, opt, lut, map, x0,
+                                           y0, x1, y1, out, samples, rays);
+                                   });
+            };
+            if (opt.interpolation == Interpolation::Nearest)
+                frame(std::true_type{});
+            else
+                frame(std::false_type{});
         });
     });
     const auto t1 = std::chrono::steady_clock::now();
