@@ -14,6 +14,7 @@
 #include "io/detached_data.h"
 #include "io/itk_support.h"
 #include "io/metaimage_data.h"
+#include "io/nrrd_data.h"
 #include "io/readers.h"
 #include "lacuna/error.h"
 
@@ -124,24 +125,29 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     const Vec3i dims = checked_dims(*io, path);
     const DiskType disk = disk_type_from_itk(io->GetComponentType(), path);
     const size_t voxels = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
-    // NRRD voxels that need conversion pass through a full-size temporary of the file's type.
-    const bool nrrd_converts = !dynamic_cast<itk::MetaImageIO*>(io.GetPointer()) &&
-                               disk != disk_type_of(stored_type(disk));
-    check_budget(path, "dims", dims_string(dims) + " " + to_string(disk),
-                 sat_add(grid_bytes(dims, voxel_size(stored_type(disk))),
-                         nrrd_converts ? grid_bytes(dims, disk_type_size(disk)) : 0),
-                 opts.max_memory);
-
-    // MetaImage: locate the voxels ourselves (see metaimage_data.cpp) and, for uncompressed
-    // data, check the length before allocating.
+    // MetaImage and (raw or gzip) NRRD: locate the voxels ourselves (metaimage_data.cpp,
+    // nrrd_data.cpp explain why) and, for uncompressed data, check the length before
+    // allocating.
+    const uint64_t data_bytes = grid_bytes(dims, disk_type_size(disk));
+    const uint64_t volume_bytes = grid_bytes(dims, voxel_size(stored_type(disk)));
+    const std::string what = dims_string(dims) + " " + to_string(disk);
+    check_budget(path, "dims", what, volume_bytes, opts.max_memory);
     std::optional<MetaDataLayout> meta;
     if (auto* mio = dynamic_cast<itk::MetaImageIO*>(io.GetPointer())) {
         MetaImage* mi = mio->GetMetaImagePointer();
         meta = metaimage_layout(path, mi->ElementDataFileName(), mi->HeaderSize(),
                                 mi->CompressedData(), mi->BinaryData(),
-                                mi->BinaryDataByteOrderMSB(), voxels * disk_type_size(disk),
+                                mi->BinaryDataByteOrderMSB(), data_bytes,
                                 opts.allow_external_data);
+    } else if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
+        const bool big = io->GetByteOrder() == itk::IOByteOrderEnum::BigEndian;
+        meta = nrrd_layout(path, data_bytes, voxels,
+                           disk_type_size(disk) > 1 && big != host_is_big_endian());
     }
+    // Voxels NrrdIO reads and that need conversion pass through a full-size temporary.
+    if (!meta && disk != disk_type_of(stored_type(disk)))
+        check_budget(path, "dims", what + " (converted through a temporary)",
+                     sat_add(volume_bytes, data_bytes), opts.max_memory);
 
     Volume v(dims, stored_type(disk), path);
     copy_geometry(*io, v);

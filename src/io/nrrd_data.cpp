@@ -1,0 +1,136 @@
+#include "io/nrrd_data.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "lacuna/error.h"
+
+namespace lacuna::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string trim(const std::string& s) {
+    const size_t b = s.find_first_not_of(" \t\r");
+    if (b == std::string::npos) return "";
+    return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+// The header's fields that place the data, and where the header ends in its own file.
+struct NrrdFields {
+    std::string encoding = "raw", data_file;
+    long long byte_skip = 0, line_skip = 0;
+    uint64_t header_end = 0;  // first byte after the blank line
+    bool has_blank_line = false;
+};
+
+NrrdFields parse_fields(const std::string& header) {
+    std::ifstream in(header, std::ios::binary);
+    NrrdFields f;
+    std::string line;
+    uint64_t pos = 0;
+    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
+        pos += line.size() + 1;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) {
+            f.has_blank_line = true;
+            break;
+        }
+        const size_t colon = line.find(':');
+        if (line[0] == '#' || colon == std::string::npos) continue;
+        const std::string key = trim(line.substr(0, colon));
+        const std::string value = trim(line.substr(colon + 1));
+        if (key == "encoding") f.encoding = to_lower(value);
+        else if (key == "data file" || key == "datafile") f.data_file = value;
+        else if (key == "byte skip" || key == "byteskip") f.byte_skip = std::atoll(value.c_str());
+        else if (key == "line skip" || key == "lineskip") f.line_skip = std::atoll(value.c_str());
+    }
+    f.header_end = pos;
+    return f;
+}
+
+// Skips `lines` newline-terminated lines from `offset`; -1 if the file ends first.
+int64_t skip_lines(const std::string& path, uint64_t offset, long long lines) {
+    if (lines <= 0) return int64_t(offset);
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(std::streamoff(offset));
+    std::vector<char> buf(size_t(1) << 16);
+    int64_t at = int64_t(offset);
+    while (lines > 0 && in) {
+        in.read(buf.data(), std::streamsize(buf.size()));
+        const std::streamsize got = in.gcount();
+        for (std::streamsize i = 0; i < got; ++i)
+            if (buf[size_t(i)] == '\n' && --lines == 0) return at + i + 1;
+        at += got;
+        if (got == 0) break;
+    }
+    return -1;
+}
+
+Error truncated(const std::string& header, uint64_t need, uint64_t have, const std::string& what) {
+    return Error(header, "voxel data",
+                 "truncated: expected " + std::to_string(need) + " bytes of " + what +
+                     ", the data file has " + std::to_string(have));
+}
+
+}  // namespace
+
+std::optional<MetaDataLayout> nrrd_layout(const std::string& header, uint64_t data_bytes,
+                                          uint64_t voxels, bool swap) {
+    const NrrdFields f = parse_fields(header);
+    const bool raw = f.encoding == "raw";
+    const bool gzip = f.encoding == "gzip" || f.encoding == "gz";
+    const bool ascii = f.encoding == "ascii" || f.encoding == "txt" || f.encoding == "text";
+    const bool hex = f.encoding == "hex";
+    // What the data must at least hold in the file: raw its bytes, hex two characters a byte,
+    // ascii one character a value; compressed data has no lower bound worth checking.
+    const uint64_t at_least = raw ? data_bytes : hex ? sat_mul(data_bytes, 2) : ascii ? voxels : 0;
+    const std::string what = raw ? "voxels" : hex ? "hex digits" : "ascii values";
+
+    std::error_code ec;
+    const fs::path dir = fs::path(header).parent_path();
+    const bool one_file = !f.data_file.empty() && f.data_file.rfind("LIST", 0) != 0 &&
+                          f.data_file.find('%') == std::string::npos;
+    // LIST or pattern (the names were checked by check_nrrd_data_files): left to NrrdIO.
+    if (!f.data_file.empty() && !one_file) return std::nullopt;
+    MetaDataLayout l;
+    l.swap = swap;
+    l.compressed = gzip;
+    if (one_file) {
+        const fs::path p(f.data_file);
+        l.path = (p.is_absolute() ? p : dir / p).string();
+        l.offset = 0;
+    } else {
+        if (!f.has_blank_line)
+            throw Error(header, "header", "the header never ends (no blank line before the data)");
+        l.path = header;
+        l.offset = int64_t(f.header_end);
+    }
+    const uint64_t size = fs::file_size(l.path, ec);
+    if (ec) throw Error(header, "voxel data", "cannot read the data file: " + ec.message());
+    const int64_t after_lines = skip_lines(l.path, uint64_t(l.offset), f.line_skip);
+    if (after_lines < 0) throw truncated(header, at_least, 0, what);
+    l.offset = after_lines;
+    if (f.byte_skip == -1) {
+        // "-1: the data is at the end of the file" (raw only).
+        if (!raw) return std::nullopt;
+        if (size < data_bytes) throw truncated(header, data_bytes, size, what);
+        l.offset = int64_t(size - data_bytes);
+    } else if (f.byte_skip < 0) {
+        throw Error(header, "byte skip", "expected -1 or a byte count >= 0, got " +
+                                             std::to_string(f.byte_skip));
+    } else if (raw) {
+        l.offset = int64_t(sat_add(uint64_t(l.offset), uint64_t(f.byte_skip)));
+    }
+    const uint64_t have = size > uint64_t(l.offset) ? size - uint64_t(l.offset) : 0;
+    if (have < at_least) throw truncated(header, at_least, have, what);
+    // gzip with a byte skip skips inflated bytes: rare, left to NrrdIO.
+    if (raw || (gzip && f.byte_skip == 0)) return l;
+    return std::nullopt;
+}
+
+}  // namespace lacuna::io
