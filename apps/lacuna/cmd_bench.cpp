@@ -38,6 +38,7 @@ struct FaludiArgs {
     bool size_given = false, views_given = false;
     std::string rows = "marching,early-exit";  // --rows: also shading, lighting
     float shadow_step = 1.f;
+    std::string interpolation = "trilinear";
 };
 
 std::vector<int> parse_int_list(const std::string& s, const std::string& where) {
@@ -88,6 +89,7 @@ void run_table(const FaludiArgs& a, const bench::OrbitSpec& orbit, const AccelOp
     if (!(a.shadow_step > 0.f && a.shadow_step <= 64.f))
         throw Error("--shadow-step", "step", "expected 0 < step <= 64");
     fo.shadow_step = a.shadow_step;
+    fo.interpolation = parse_interpolation(a.interpolation);
     const auto ids = parse_datasets(a.datasets, "--datasets");
     bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench faludi"));
     std::printf("lacuna bench faludi: %dx%d, %d views, %zu datasets, %s, %d threads\n", orbit.size,
@@ -248,6 +250,10 @@ void register_bench(CLI::App& app) {
     f->add_option("--rows", a->rows,
                   "Comma-separated rows: marching, early-exit, shading (+ PBR shading), lighting "
                   "(+ spotlight with shadow rays)")
+        ->capture_default_str();
+    f->add_option("--interpolation", a->interpolation,
+                  "Sampling of every row: trilinear, or nearest (structures built for it; the ideal "
+                  "counts samples whose voxel is visible)")
         ->capture_default_str();
     f->add_option("--shadow-step", a->shadow_step, "Shadow-ray sample distance of the lighting row")
         ->capture_default_str();

@@ -29,6 +29,7 @@ StructureResult build_structure(AccelKind k, const BenchDataset& d, const Faludi
     s.kind = k;
     AccelOptions ao = o.accel;
     ao.threads = o.threads;
+    ao.interpolation = o.interpolation;
     const auto t0 = std::chrono::steady_clock::now();
     accel = make_accel(k, *d.volume, ao);
     accel->set_transfer_function(d.lut);
@@ -215,6 +216,7 @@ RowMode parse_row_mode(const std::string& name) {
 RenderOptions row_render_options(const FaludiOptions& o, RowMode m, const Box3f& bounds) {
     RenderOptions ro;
     ro.step = o.step;
+    ro.interpolation = o.interpolation;
     ro.ert = m == RowMode::MarchingOnly ? 2.f : o.ert;
     ro.threads = o.threads;
     if (m == RowMode::Shading || m == RowMode::Lighting) {

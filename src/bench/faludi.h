@@ -43,6 +43,9 @@ struct FaludiOptions {
     int tf_repeats = 3;  // TF changes timed per structure (the median is reported)
     bool ideal = true;   // count visible-cell samples (the ideal speedup)
     float shadow_step = 1.f;  // '+ Lighting': shadow-ray sample distance (smallest spacings)
+    // Every row samples this way, every structure is built for it (AccelOptions::interpolation);
+    // under Nearest the ideal counts samples whose own voxel is visible.
+    Interpolation interpolation = Interpolation::Trilinear;
 };
 
 // The render options of a row for a volume with world box `bounds` (the '+ Lighting' spotlight

@@ -62,7 +62,7 @@ bool pixel_ray(const Camera& cam, const Vec3f& inv_sp, const float hi[3], float 
 template <class T>
 uint64_t count_tile(const kernel::Grid<T, int64_t>& g, const VisibleCells& cells, const Volume& vol,
                     const Camera& cam, const std::vector<Rgba>& lut, ValueToLut map, float dt,
-                    float ert, int x0, int y0, int x1, int y1) {
+                    float ert, bool nearest, int x0, int y0, int x1, int y1) {
     const Vec3f inv_sp = inverse_spacing(vol);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     const bool use_ert = ert < 1.f;
@@ -85,6 +85,16 @@ uint64_t count_tile(const kernel::Grid<T, int64_t>& g, const VisibleCells& cells
                 pz = pz < 0.f ? 0.f : (pz > g.hi_z ? g.hi_z : pz);
                 const int i = std::min(int(px), g.cell_x), j = std::min(int(py), g.cell_y),
                           k = std::min(int(pz), g.cell_z);
+                // Nearest: the sample's own voxel decides (its opacity is the sample's).
+                if (nearest) {
+                    const float a = lut[size_t(map(kernel::nearest(g, px, py, pz)))].a;
+                    if (!(a > 0.f)) continue;
+                    ++n;
+                    if (!use_ert) continue;
+                    acc.a += (1.f - acc.a) * a;
+                    if (acc.a >= ert) break;
+                    continue;
+                }
                 // 3. Invisible cell: opacity 0, compositing is the identity, nothing to count.
                 if (!cells.visible(i, j, k)) continue;
                 ++n;
@@ -118,7 +128,8 @@ uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut,
         const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, d);
         parallel_for_tiles(
             cam.width(), cam.height(), opt.tile, opt.threads, [&](int x0, int y0, int x1, int y1) {
-                total += count_tile(g, cells, vol, cam, table, map, dt, opt.ert, x0, y0, x1, y1);
+                total += count_tile(g, cells, vol, cam, table, map, dt, opt.ert,
+                                    opt.interpolation == Interpolation::Nearest, x0, y0, x1, y1);
             });
     });
     return total;

@@ -14,6 +14,10 @@
 // reference (skipped samples have opacity 0, and compositing them is the identity, so the
 // accumulated opacity is bit for bit the reference's).
 //
+// Under nearest sampling (RenderOptions::interpolation) a sample reads one voxel, and a perfect
+// structure drops exactly the samples whose voxel maps to a transparent entry: the count is then
+// of samples whose own value is visible (the cells are not consulted).
+//
 // Cell ranges come from src/accel/cell_ranges.h, the structures' own raw material (float32
 // corners widened by a relative 1e-6, conservative: a cell on a rounding boundary counts as
 // visible).

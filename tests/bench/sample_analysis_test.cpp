@@ -175,6 +175,36 @@ TEST(SampleAnalysis, HandBuiltPlaneCountsFourSamplesPerRay) {
     EXPECT_EQ(count_visible_cell_samples(v, lut, cells, cam, options(0.99f)), 1 * ref.rays);
 }
 
+// The same plane under nearest sampling: of y = 9.25, 9.75, 10.25, 10.75 only 9.75 and 10.25 read
+// voxel j = 10 (floor(y + 0.5)), so two samples per ray are visible, one with ERT; and a grid
+// built for nearest takes exactly those.
+TEST(SampleAnalysis, NearestCountsSamplesWhoseVoxelIsVisible) {
+    Volume v({6, 17, 6}, VoxelType::UInt8);
+    for (int k = 0; k < 6; ++k)
+        for (int i = 0; i < 6; ++i) v.set_value(i, 10, k, 255);
+    v.compute_range();
+    const TransferLut lut = band_lut({0, 255}, 1, kDefaultLutSize - 1, 1.f);
+    const VisibleCells cells(v, lut);
+    const Camera cam = orbit_camera(v, 0, 0, 8, Projection::Orthographic);
+    RayMarcher m(v);
+    m.set_transfer_function(lut);
+    RenderOptions o = options(2.f);
+    o.interpolation = Interpolation::Nearest;
+    const RenderStats ref = m.render(cam, o).stats;
+    ASSERT_GT(ref.rays, 0u);
+    EXPECT_EQ(count_visible_cell_samples(v, lut, cells, cam, o), 2 * ref.rays);
+    AccelOptions ao;
+    ao.interpolation = Interpolation::Nearest;
+    ao.leaf_cells = 2;
+    auto grid = make_accel(AccelKind::Grid, v, ao);
+    grid->set_transfer_function(lut);
+    m.set_accel(grid.get());
+    EXPECT_GE(m.render(cam, o).stats.samples, 2 * ref.rays);
+    RenderOptions e = options(0.99f);
+    e.interpolation = Interpolation::Nearest;
+    EXPECT_EQ(count_visible_cell_samples(v, lut, cells, cam, e), 1 * ref.rays);
+}
+
 TEST(SampleAnalysis, MatchesBruteForceOnSyntheticVolumes) {
     struct Case {
         SyntheticKind kind;
