@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <type_traits>
 
 #include "core/parallel.h"
 
@@ -50,32 +51,58 @@ void BrickGrid::build() {
 }
 
 // Per brick the bins of its apron voxels [B*b - 1, B*b + B + 1] (clipped), each voxel mapped as a
-// nearest sample maps it (ValueToLut of the value itself). A brick's voxels are visited once per
-// brick that holds them (about (B + 3)^3 / B^3 times each), in parallel over brick layers.
+// nearest sample maps it (ValueToLut of the value itself). The union over a box is separable: per
+// layer of bricks (bz), every voxel row of its apron slices is reduced once along x into per-brick
+// masks, then those are ORed over each brick's apron rows in y and z. Integer voxels look their
+// bin bit up in a table per value. In parallel over brick layers.
 void BrickGrid::build_nearest_bins() {
     const Vec3i d = m_volume.dims();
-    const int B = 1 << m_log2, size = m_map.size();
+    const int B = 1 << m_log2, size = m_map.size(), nbx = m_nb[0];
     m_bins.assign(m_lo.size(), 0);
+    auto bit_of = [&](float v) { return uint64_t(1) << (int64_t(m_map(v)) * 64 / size); };
     visit_voxels(m_volume, [&](const auto* data) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
+        constexpr bool kTable = sizeof(T) <= 2;
+        constexpr int kBias = std::is_signed_v<T> ? 32768 : 0;
+        std::vector<uint64_t> table;
+        if constexpr (kTable) {
+            table.resize(sizeof(T) == 1 ? 256 : 65536);
+            for (size_t i = 0; i < table.size(); ++i) table[i] = bit_of(float(int(i) - kBias));
+        }
         parallel_for(size_t(m_nb[2]), m_opts.threads, [&](size_t z0, size_t z1) {
-            std::vector<uint64_t> row(size_t(d.x));  // per voxel of a row, its bin's bit
-            for (int bz = int(z0); bz < int(z1); ++bz)
-                for (int by = 0; by < m_nb[1]; ++by) {
-                    const int k0 = std::max(B * bz - 1, 0), k1 = std::min(B * bz + B + 1, d.z - 1);
-                    const int j0 = std::max(B * by - 1, 0), j1 = std::min(B * by + B + 1, d.y - 1);
-                    for (int k = k0; k <= k1; ++k)
-                        for (int j = j0; j <= j1; ++j) {
-                            const auto* v = data + (size_t(k) * size_t(d.y) + size_t(j)) * size_t(d.x);
-                            for (int i = 0; i < d.x; ++i)
-                                row[size_t(i)] = uint64_t(1) << (int64_t(m_map(float(v[i]))) * 64 / size);
-                            for (int bx = 0; bx < m_nb[0]; ++bx) {
-                                const int i0 = std::max(B * bx - 1, 0), i1 = std::min(B * bx + B + 1, d.x - 1);
-                                uint64_t m = 0;
-                                for (int i = i0; i <= i1; ++i) m |= row[size_t(i)];
-                                m_bins[slot(bx, by, bz)] |= m;
-                            }
+            std::vector<uint64_t> row(size_t(d.x)), xmask;
+            for (int bz = int(z0); bz < int(z1); ++bz) {
+                const int k0 = std::max(B * bz - 1, 0), k1 = std::min(B * bz + B + 1, d.z - 1);
+                // xmask[(k - k0) * d.y + j][bx]: the bins of row (j, k) within brick bx's apron.
+                xmask.assign(size_t(k1 - k0 + 1) * size_t(d.y) * size_t(nbx), 0);
+                for (int k = k0; k <= k1; ++k)
+                    for (int j = 0; j < d.y; ++j) {
+                        const T* v = data + (size_t(k) * size_t(d.y) + size_t(j)) * size_t(d.x);
+                        for (int i = 0; i < d.x; ++i) {
+                            if constexpr (kTable)
+                                row[size_t(i)] = table[size_t(int(v[i]) + kBias)];
+                            else
+                                row[size_t(i)] = bit_of(float(v[i]));
                         }
+                        uint64_t* out = &xmask[(size_t(k - k0) * size_t(d.y) + size_t(j)) * size_t(nbx)];
+                        for (int bx = 0; bx < nbx; ++bx) {
+                            const int i0 = std::max(B * bx - 1, 0), i1 = std::min(B * bx + B + 1, d.x - 1);
+                            uint64_t m = 0;
+                            for (int i = i0; i <= i1; ++i) m |= row[size_t(i)];
+                            out[bx] = m;
+                        }
+                    }
+                for (int by = 0; by < m_nb[1]; ++by) {
+                    const int j0 = std::max(B * by - 1, 0), j1 = std::min(B * by + B + 1, d.y - 1);
+                    for (int bx = 0; bx < nbx; ++bx) {
+                        uint64_t m = 0;
+                        for (int k = k0; k <= k1; ++k)
+                            for (int j = j0; j <= j1; ++j)
+                                m |= xmask[(size_t(k - k0) * size_t(d.y) + size_t(j)) * size_t(nbx) + size_t(bx)];
+                        m_bins[slot(bx, by, bz)] = m;
+                    }
                 }
+            }
         });
     });
 }
@@ -162,7 +189,7 @@ void BrickGrid::set_transfer_function(const TransferLut& lut) {
             const uint16_t* l = lo + w * 64;
             const uint16_t* h = hi + w * 64;
             for (int b = 0; b < 64; ++b) bits |= uint64_t(next[l[b]] <= h[b]) << b;
-            if (!m_bins.empty()) {
+            if (bits && !m_bins.empty()) {
                 const uint64_t* bins = m_bins.data() + w * 64;
                 for (int b = 0; b < 64; ++b) bits &= ~(uint64_t((bins[b] & m_tf_bins) == 0) << b);
             }

@@ -24,6 +24,7 @@ constexpr Entry kDatasets[] = {
     {DatasetId::Ch2betterGap, "ch2better-gap", "ch2better.nii.gz", "mr-gap"},
     {DatasetId::Ch2betBrain, "ch2bet-brain", "ch2bet.nii.gz", "mr-brain"},
     {DatasetId::Aal, "aal", "aal.nii.gz", "mr-default"},
+    {DatasetId::AalLabels, "aal-labels", "aal.nii.gz", "label-band"},
     {DatasetId::Inia19, "inia19", "inia19-t1-brain.nii.gz", "mr-brain"},
     {DatasetId::Tree512, "tree512", nullptr, "mr-default"},
 };

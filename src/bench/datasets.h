@@ -18,6 +18,7 @@ enum class DatasetId {
     Ch2betterGap,    // ch2better.nii.gz, mr-gap (an opacity gap: the paper's Figure 3 case)
     Ch2betBrain,     // ch2bet.nii.gz (skull-stripped), mr-brain
     Aal,             // aal.nii.gz, the AAL atlas read as a scalar volume, mr-default
+    AalLabels,       // aal.nii.gz, label-band (six labels: the case for nearest sampling)
     Inia19,          // inia19-t1-brain.nii.gz (float32), mr-brain
     Tree512,         // generated sparse tree-like volume, 512^3 uint8 (in memory only)
 };

@@ -136,6 +136,20 @@ TransferFunction mr_gap() {
                  {1.0, 0.6f}});
 }
 
+// A band of atlas labels (label volumes such as mricron's aal.nii.gz, values 0..116): opacity
+// steps up at 0.34 and down at 0.39 of the range (AAL labels 40..45), zero elsewhere. Under
+// trilinear sampling every edge between labels either side of the band passes through it; with
+// --interpolation nearest only those labels show, and value sets with holes skip the rest.
+TransferFunction label_band() {
+    return make("label-band",
+                {{0.0, 0.2f, 0.4f, 1.0f},
+                 {0.34, 0.9f, 0.3f, 0.2f},
+                 {0.365, 0.95f, 0.85f, 0.3f},
+                 {0.39, 0.3f, 0.8f, 0.4f},
+                 {1.0, 0.5f, 0.5f, 1.0f}},
+                {{0.0, 0.f}, {0.34, 0.f}, {0.34, 0.8f}, {0.39, 0.8f}, {0.39, 0.f}, {1.0, 0.f}});
+}
+
 struct PresetEntry {
     const char* name;
     TransferFunction (*make)();
@@ -143,7 +157,7 @@ struct PresetEntry {
 constexpr PresetEntry kPresets[] = {
     {"ct-bone", ct_bone},       {"ct-skin", ct_skin}, {"ct-soft-tissue", ct_soft_tissue},
     {"mr-default", mr_default}, {"mr-skin", mr_skin}, {"mr-brain", mr_brain},
-    {"mr-gap", mr_gap},
+    {"mr-gap", mr_gap},         {"label-band", label_band},
 };
 
 std::string joined_names() {

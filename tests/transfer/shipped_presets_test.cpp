@@ -15,7 +15,7 @@ namespace {
 TEST(ShippedPresets, EachFileReadsBackEqualToTheBuiltIn) {
     const std::string dir = std::string(LACUNA_SOURCE_DIR) + "/presets/";
     const bool regenerate = std::getenv("LACUNA_REGENERATE_PRESETS") != nullptr;
-    ASSERT_EQ(preset_names().size(), 7u);
+    ASSERT_EQ(preset_names().size(), 8u);
     for (const std::string& name : preset_names()) {
         const std::string path = dir + name + ".json";
         if (regenerate) std::ofstream(path) << to_json(preset(name));
