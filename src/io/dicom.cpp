@@ -36,6 +36,7 @@
 #include <map>
 #include <numeric>
 #include <random>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -84,19 +85,25 @@ void check_folder_entries(const std::string& dir) {
     if (ec) throw Error(dir, "DICOM series", "cannot list the folder: " + ec.message());
 }
 
-std::vector<std::string> series_files(const std::string& dir) {
+struct SeriesFiles {
+    std::vector<std::string> files;  // the series read: the one with the most slices
+    std::set<std::string> in_any;    // every file GDCM put into some series (normalised paths)
+};
+
+SeriesFiles series_files(const std::string& dir) {
     try {
         auto names = itk::GDCMSeriesFileNames::New();
         names->SetUseSeriesDetails(true);
         names->SetDirectory(dir);
         const std::vector<std::string> uids = names->GetSeriesUIDs();
-        std::vector<std::string> best;
+        SeriesFiles out;
         // Several series in one folder: take the one with the most slices.
         for (const auto& uid : uids) {
             std::vector<std::string> files = names->GetFileNames(uid);
-            if (files.size() > best.size()) best = std::move(files);
+            for (const auto& f : files) out.in_any.insert(fs::path(f).lexically_normal().string());
+            if (files.size() > out.files.size()) out.files = std::move(files);
         }
-        return best;
+        return out;
     } catch (const std::exception& e) {
         throw Error(dir, "DICOM series", itk_message(e));
     }
@@ -303,8 +310,17 @@ void read_series_child(const std::string& dir, const MemoryBudget& budget, int m
         const auto w = walks.find(fs::path(file).lexically_normal().string());
         return w == walks.end() ? DicomWalk{} : w->second;
     };
-    std::vector<std::string> files = series_files(dir);
+    SeriesFiles series = series_files(dir);
+    std::vector<std::string>& files = series.files;
     if (files.empty()) throw Error(dir, "DICOM series", "no DICOM series found in this folder");
+    // GDCM's scanner skips files it cannot parse: a damaged slice would vanish from the series
+    // without a word. A file that claims to be DICOM ("DICM" at byte 128, or named .dcm) and
+    // is in no series is an error; other files (notes, thumbnails) are ignored.
+    for (const auto& [path, walk] : walks)
+        if ((walk.part10 || to_lower(fs::path(path).extension().string()) == ".dcm") &&
+            !series.in_any.count(path))
+            throw Error(dir, file_name(path),
+                        "is a DICOM file that GDCM could not place in any series (damaged?)");
 
     auto io = itk::GDCMImageIO::New();
     ch.working_on(files[0]);

@@ -55,7 +55,7 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
         uint8_t h[12];
         in.seekg(std::streamoff(pos));
         in.read(reinterpret_cast<char*>(h), 8);
-        if (in.gcount() != 8) break;
+        if (in.gcount() != 8) return w;  // read error: left to GDCM
         const uint16_t g0 = u16(h, false);
         if (in_meta && g0 != 0x0002) {
             // The meta group ended: switch to the data set's transfer syntax (PS3.5 Annex A).
@@ -72,7 +72,10 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
         if (g == 0xFFFE) return w;  // item tags at top level: leave to GDCM
         if (has_vr && long_vr(vr)) {
             in.read(reinterpret_cast<char*>(h + 8), 4);
-            if (in.gcount() != 4) break;
+            if (in.gcount() != 4) {
+                pos = size - 1;  // a long-VR header cut short
+                break;
+            }
             len = u32(h + 8, big);
             head = 12;
         } else if (has_vr) {
@@ -97,6 +100,16 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
         }
         pos += head + len;
     }
+    // Bytes left over that cannot hold an element header: GDCM asserts on these
+    // (gdcmExplicitDataElement.txx: Assertion '0 && "Should not happen"').
+    if (pos < size)
+        throw Error(dir, name,
+                    "the file ends inside an element header at byte " + std::to_string(pos) +
+                        " (a truncated slice)");
+    if (in_meta)
+        throw Error(dir, name,
+                    "the file ends inside its file meta information (group 0002) at byte " +
+                        std::to_string(pos) + " (a truncated slice)");
     return w;
 }
 

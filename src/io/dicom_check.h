@@ -20,7 +20,9 @@ struct DicomWalk {
 };
 
 // Throws Error(dir, <file name>, "element (gggg,eeee) says N bytes, M are left in the file
-// (a damaged or truncated slice)") for a length that runs past the end of the file.
+// (a damaged or truncated slice)") for a length that runs past the end of the file, and
+// "the file ends inside an element header" for a file cut inside a tag/VR/length (GDCM
+// asserts on that one: found by fuzz_dicom_dir).
 DicomWalk walk_dicom_file(const std::string& file, const std::string& dir);
 
 }  // namespace lacuna::io

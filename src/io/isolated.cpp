@@ -107,6 +107,10 @@ void run_isolated(const std::string& where, const std::string& field, const std:
     }
     if (pid == 0) {
         ::close(fds[0]);
+        // Fatal signals kill the child, whatever handlers the parent installed (libFuzzer's
+        // would turn GDCM's abort into an ordinary exit): a death is then always a signal.
+        // Sanitizer reports (ASan, UBSan) still end the child with their own exit code.
+        for (int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL}) ::signal(sig, SIG_DFL);
         // LACUNA_CHILD_STDERR=1 keeps stderr (to read a sanitizer's report from the child).
         if (!std::getenv("LACUNA_CHILD_STDERR")) {
             const int null = ::open("/dev/null", O_RDWR);

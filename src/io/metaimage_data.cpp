@@ -12,6 +12,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -88,25 +89,42 @@ class Inflater {
 }  // namespace
 
 void check_metaimage_header(const std::string& path) {
+    // Headers are a few hundred bytes: look at the first MiB, up to ElementDataFile (the last
+    // key). MetaIO parses on past where we stop, so a header without ElementDataFile there is
+    // rejected here rather than parsed by MetaIO unchecked.
+    constexpr size_t kWindow = size_t(1) << 20;
+    constexpr size_t kMaxField = 254;  // MetaIO strcpy()s keys and values into char[255]
     std::ifstream in(path, std::ios::binary);
-    std::string line;
-    // Headers are a few hundred bytes; stop at the data (ElementDataFile is the last key).
-    for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
+    std::string head(kWindow, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(size_t(in.gcount()));
+    const auto trim = [](std::string t) {
+        t.erase(t.find_last_not_of(" \t\r") + 1);
+        t.erase(0, t.find_first_not_of(" \t"));
+        return t;
+    };
+    for (size_t pos = 0, n = 1; pos < head.size(); ++n) {
+        const size_t eol = std::min(head.find('\n', pos), head.size());
+        const std::string line = head.substr(pos, eol - pos);
+        pos = eol + 1;
         const size_t eq = line.find('=');
+        const std::string key = trim(line.substr(0, eq));
+        const std::string value = eq == std::string::npos ? "" : trim(line.substr(eq + 1));
+        if (key.size() > kMaxField || value.size() > kMaxField)
+            throw Error(path, "header",
+                        "line " + std::to_string(n) + " has a " +
+                            (key.size() > kMaxField ? "key" : "value") + " of " +
+                            std::to_string(std::max(key.size(), value.size())) +
+                            " characters, MetaImage allows " + std::to_string(kMaxField));
         if (eq == std::string::npos) continue;
-        std::string key = line.substr(0, eq);
-        key.erase(key.find_last_not_of(" \t") + 1);
-        key.erase(0, key.find_first_not_of(" \t"));
         if (to_lower(key) == "elementdatafile") return;
         if (to_lower(key) != "ndims") continue;
-        std::string value = line.substr(eq + 1);
-        value.erase(value.find_last_not_of(" \t\r") + 1);
-        value.erase(0, value.find_first_not_of(" \t"));
         if (value != "3" && value != "4")
             throw Error(path, "header",
                         "expected NDims = 3 (or 4 with a last size of 1), got '" +
                             one_line(value, 40) + "'");
     }
+    throw Error(path, "header", "no ElementDataFile line in the first MiB of the header");
 }
 
 std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,

@@ -19,7 +19,11 @@ struct MetaDataLayout {
 
 // Guards MetaIO against headers it mishandles: MetaIO reads NDims-long (and NDims^2-long)
 // fields without checking NDims, so "NDims = -3" makes it try to read billions of numbers.
-// Throws Error(path, "header", ...) unless NDims is 3 or 4. Call before ITK reads the header.
+// Throws Error(path, "header", ...) unless NDims is 3 or 4. Also guards MetaIO's fixed 255-byte
+// field buffers (a 256-character key or value aborted the process through glibc's fortify
+// check, found by fuzz_metaimage): every key and value up to ElementDataFile is at most 254
+// characters, and ElementDataFile must come within the first MiB. Call before ITK reads the
+// header.
 void check_metaimage_header(const std::string& path);
 
 // Locates the voxel data described by a parsed MetaImage header; nullopt for ASCII voxels,

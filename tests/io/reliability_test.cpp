@@ -205,6 +205,23 @@ std::string mhd(const std::string& data) {
            "ElementDataFile = " + data + "\n";
 }
 
+// MetaIO strcpy()s header fields into char[255]: a 256-character key or value aborted the
+// process (glibc's fortify check; found by fuzz_metaimage).
+TEST(IoMetaImage, OverlongHeaderFieldsAreErrorsNotAborts) {
+    ScratchDir dir;
+    const std::string head = "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n";
+    const std::string tail = "ElementDataFile = LOCAL\n" + std::string(8, '\0');
+    test::write_text(dir.file("key.mha"), head + std::string(256, 'K') + " = 1\n" + tail);
+    test::write_text(dir.file("name.mha"), head + "Name = " + std::string(300, 'x') + "\n" + tail);
+    test::write_text(dir.file("ok.mha"), head + "Name = " + std::string(254, 'x') + "\n" + tail);
+    EXPECT_NE(read_error(dir.file("key.mha")).find("line 5 has a key of 256 characters"),
+              std::string::npos);
+    EXPECT_NE(read_error(dir.file("name.mha")).find("a value of 300 characters"), std::string::npos);
+    EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
+    test::write_text(dir.file("endless.mha"), head + std::string(size_t(1) << 20, '\n'));
+    EXPECT_NE(read_error(dir.file("endless.mha")).find("no ElementDataFile"), std::string::npos);
+}
+
 TEST(IoDetached, DataFileOutsideTheHeadersFolderNeedsPermission) {
     ScratchDir dir, other;
     test::write_bytes(other.file("data.raw"), std::vector<uint8_t>(64, 7));
@@ -448,6 +465,27 @@ TEST(IoDicomFolder, HugeDamagedLengthIsAnErrorBeforeGdcmAllocates) {
     EXPECT_NE(msg.find("slice_00001.dcm: element (7FE0,0010) says 805306368 bytes"),
               std::string::npos)
         << msg;
+}
+
+// A slice cut inside an element header made GDCM assert (found by fuzz_dicom_dir): the walk
+// reports it before GDCM sees the file; cut anywhere, the answer is an error line.
+TEST(IoDicomFolder, SliceCutInsideAnElementHeaderIsAnError) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    const std::string victim = s + "/slice_00001.dcm";
+    const std::vector<uint8_t> good = test::file_bytes(victim);
+    test::write_bytes(victim, good.data(), 138);  // "DICM", then half of (0002,0000) UL
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("slice_00001.dcm: the file ends inside an element header at byte 132"),
+              std::string::npos)
+        << msg;
+    for (size_t cut = 0; cut < good.size(); cut += 7) {
+        test::write_bytes(victim, good.data(), cut);
+        // An error from our checks (never GDCM dying, never a series one slice short).
+        const std::string m = read_error(s);
+        EXPECT_EQ(m.find("died"), std::string::npos) << "cut at " << cut << ": " << m;
+        EXPECT_NE(m.find("slice_00001.dcm"), std::string::npos) << "cut at " << cut << ": " << m;
+    }
 }
 
 TEST(IoDicomFolder, ShortPixelDataIsAnErrorNotAShortSlice) {
