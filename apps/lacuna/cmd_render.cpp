@@ -1,6 +1,7 @@
 // `lacuna render`: one frame of a volume to a PNG, with timing and sample statistics; or, with
 // --tf-animate, a sequence while the TF moves between two TFs (bitfield paper, Section 4.5),
 // reporting per structure the time from a TF change to ready-to-render.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -109,6 +110,10 @@ Setup validate(RenderArgs& a) {
         throw Error("--size", "image size", "expected 1..16384 pixels per side");
     if (!(a.step > 0.f && a.step <= 64.f)) throw Error("--step", "step", "expected 0 < step <= 64");
     if (!(a.ert > 0.f && a.ert <= 1.f)) throw Error("--ert", "threshold", "expected 0 < ert <= 1");
+    if (!(a.zoom > 0.f && a.zoom <= 1000.f)) throw Error("--zoom", "zoom", "expected 0 < zoom <= 1000");
+    if (!(a.fov > 0.f && a.fov < 180.f)) throw Error("--fov", "field of view", "expected 0 < degrees < 180");
+    if (!std::isfinite(a.azimuth) || !std::isfinite(a.elevation))
+        throw Error("--azimuth/--elevation", "angle", "expected finite degrees");
     if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
     s.ro.step = a.step;
     s.ro.interpolation = parse_interpolation(a.interpolation);

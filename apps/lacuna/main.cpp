@@ -1,11 +1,50 @@
 // lacuna — command-line entry point. Every lacuna::Error becomes one line on stderr and exit
 // code 2; usage errors exit 2 as well (docs/cli.md).
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "cli_common.h"
 #include "lacuna/error.h"
+
+namespace {
+
+// Edit distance, for "did you mean" on a mistyped subcommand.
+size_t distance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+// CLI11 reports a mistyped subcommand as "A subcommand is required"; name it instead.
+void check_subcommand(const CLI::App& app, int argc, char** argv) {
+    if (argc < 2 || argv[1][0] == '-') return;
+    const std::string word = argv[1];
+    std::string names, best;
+    size_t best_d = 3;  // suggest only close matches
+    for (const CLI::App* s : app.get_subcommands([](const CLI::App*) { return true; })) {
+        if (s->get_name() == word) return;
+        names += (names.empty() ? "" : ", ") + s->get_name();
+        if (const size_t d = distance(word, s->get_name()); d < best_d) best_d = d, best = s->get_name();
+    }
+    throw lacuna::Error("unknown command '" + word + "'" +
+                        (best.empty() ? "" : " (did you mean '" + best + "'?)") +
+                        "; expected one of: " + names);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"lacuna: direct volume rendering with exact empty-space skipping"};
@@ -18,6 +57,7 @@ int main(int argc, char** argv) {
     lacuna::cli::register_partition(app);
     lacuna::cli::register_serve(app);
     try {
+        check_subcommand(app, argc, argv);
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);

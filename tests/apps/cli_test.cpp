@@ -138,6 +138,15 @@ TEST(Cli, BadOptionsAreOneLineExit2) {
     expect_one_line_error(run("generate tree --dims 100000x100000x100000 --out x.nrrd"), "dims");
     expect_one_line_error(run("generate teapot --out x.nrrd"), "teapot");
     expect_one_line_error(run("render --frobnicate"), "frobnicate");
+    expect_one_line_error(run("rendr " + v), "did you mean 'render'");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --zoom -1 --out x.png"), "--zoom");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --zoom 0 --out x.png"), "--zoom");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --fov 180 --out x.png"), "--fov");
+    expect_one_line_error(run("render " + v + " --tf mr-skin --interpolation cubic --out x.png"),
+                          "--interpolation");
+    expect_one_line_error(
+        run("render " + v + " --tf mr-skin --interpolation nearest --renderer slice --out x.png"),
+        "--interpolation");
     EXPECT_FALSE(fs::exists("x.png"));
     EXPECT_FALSE(fs::exists("x.nrrd"));
 }
