@@ -250,8 +250,6 @@ void run(RenderArgs& a) {
         else if (a.slice.renderer == "slice") a.accel = "none";
     }
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
-    if (s.ro.interpolation == Interpolation::Nearest && (a.segments.active() || a.slice.renderer == "slice"))
-        throw Error("--interpolation", "nearest", "supported by the ray marcher only (not with --labels/--segments or --renderer slice)");
     // Shading, lights, clipping, blend modes and jitter live in the ray marcher's feature kernel.
     if (s.ro.features.any() || !a.features.tf_back.empty()) {
         if (a.segments.active())

@@ -70,6 +70,7 @@ void render_slice(const SliceCliArgs& a, const SliceRenderJob& job) {
     o.ert = job.render.ert;
     o.threads = job.render.threads;
     o.background = job.render.background;
+    o.nearest = job.render.interpolation == Interpolation::Nearest;
     if (a.occlusion) {
         o.occlusion.mode = OcclusionMode::CullClip;
         o.occlusion.threshold = a.occlusion_threshold;

@@ -61,6 +61,7 @@ struct Frame {
     int table_size;
     float tint;
     bool masked;
+    bool nearest;  // intensity samples by Interpolation::Nearest
     RenderResult& out;
     std::atomic<uint64_t>& samples;
     std::atomic<uint64_t>& rays;
@@ -102,7 +103,8 @@ void render_tile(const S& accel, const Volume& geom, const T* data, const L* lab
                     if (ls.a == 0.f) return true;
                     Rgba c;
                     if (f.masked) {
-                        const Rgba& tc = f.lut[f.map(kernel::trilinear(g, px, py, pz))];
+                        const Rgba& tc = f.lut[f.map(f.nearest ? kernel::nearest(g, px, py, pz)
+                                                               : kernel::trilinear(g, px, py, pz))];
                         // Premultiplied: the TF colour mixed with the label's, then the
                         // label's opacity factor.
                         const float keep = 1.f - f.tint;
@@ -189,6 +191,10 @@ RenderResult SegmentRenderer::render(const Camera& cam, const RenderOptions& opt
         throw Error("render", "transfer function", "none was set (mask mode)");
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
         throw Error("--step", "step", "expected a positive number");
+    if (im.accel && im.accel->interpolation() == Interpolation::Nearest &&
+        opt.interpolation != Interpolation::Nearest)
+        throw Error("--interpolation", "sampling",
+                    "the structure was built for nearest sampling; expected --interpolation nearest");
     RenderResult out;
     out.image = Image(cam.width(), cam.height());
     if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);
@@ -203,7 +209,8 @@ RenderResult SegmentRenderer::render(const Camera& cam, const RenderOptions& opt
     }
     std::atomic<uint64_t> samples{0}, rays{0};
     const Frame f{cam, opt, lut.data(), masked ? im.lut.map() : ValueToLut{}, table.data(),
-                  int(table.size()), im.opts.tint, masked, out, samples, rays};
+                  int(table.size()), im.opts.tint, masked,
+                  opt.interpolation == Interpolation::Nearest, out, samples, rays};
     // Labels mode samples no intensity: the label volume stands in as the (unused) grid.
     const Volume& geom = masked ? *im.intensity : im.labels;
     const auto t0 = std::chrono::steady_clock::now();

@@ -181,7 +181,8 @@ constexpr float kMargin = 0.05f;
 template <class T>
 void raster_tile(const kernel::Grid<T, int64_t>& g, const Rgba* lut, ValueToLut map,
                  const PixelRays& px, const std::vector<const BoxWork*>& batch, float dt, float ert,
-                 int width, int x0, int y0, int x1, int y1, kernel::Accum* fb, uint64_t& samples) {
+                 bool nearest, int width, int x0, int y0, int x1, int y1, kernel::Accum* fb,
+                 uint64_t& samples) {
     for (const BoxWork* b : batch) {
         if (b->polys.empty() || b->umax < float(x0) - 1.f || b->umin > float(x1) + 1.f ||
             b->vmax < float(y0) - 1.f || b->vmin > float(y1) + 1.f)
@@ -224,7 +225,8 @@ void raster_tile(const kernel::Grid<T, int64_t>& g, const Rgba* lut, ValueToLut 
                           sx >= b->clo[0] && sx <= b->chi[0] && sy >= b->clo[1] &&
                           sy <= b->chi[1] && sz >= b->clo[2] && sz <= b->chi[2]))
                         continue;
-                    const Rgba& c = lut[map(kernel::trilinear(g, sx, sy, sz))];
+                    const Rgba& c = lut[map(nearest ? kernel::nearest(g, sx, sy, sz)
+                                                    : kernel::trilinear(g, sx, sy, sz))];
                     ++samples;
                     const float w = 1.f - acc.a;
                     acc.r += w * c.r;
@@ -410,8 +412,8 @@ SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
             parallel_for_tiles(W, H, std::max(opt.tile, 1), opt.threads,
                                [&](int x0, int y0, int x1, int y1) {
                                    uint64_t n = 0;
-                                   raster_tile(g, lut.data(), vmap, px, batch, f.dt_f, ert, W,
-                                               x0, y0, x1, y1, fb.data(), n);
+                                   raster_tile(g, lut.data(), vmap, px, batch, f.dt_f, ert,
+                                               opt.nearest, W, x0, y0, x1, y1, fb.data(), n);
                                    samples += n;
                                });
         });

@@ -41,6 +41,7 @@ struct SliceOptions {
     int threads = 0;    // 0 = all hardware threads
     Vec3f background{0, 0, 0};
     bool keep_float = false;  // fill SliceResult::rgba_float
+    bool nearest = false;     // nearest-voxel samples (lacuna/accel.h, Interpolation::Nearest)
     int tile = 32;            // framebuffer tile edge in pixels
     OcclusionOptions occlusion;
 };

@@ -144,9 +144,7 @@ TEST(Cli, BadOptionsAreOneLineExit2) {
     expect_one_line_error(run("render " + v + " --tf mr-skin --fov 180 --out x.png"), "--fov");
     expect_one_line_error(run("render " + v + " --tf mr-skin --interpolation cubic --out x.png"),
                           "--interpolation");
-    expect_one_line_error(
-        run("render " + v + " --tf mr-skin --interpolation nearest --renderer slice --out x.png"),
-        "--interpolation");
+
     EXPECT_FALSE(fs::exists("x.png"));
     EXPECT_FALSE(fs::exists("x.nrrd"));
 }

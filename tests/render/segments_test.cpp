@@ -177,16 +177,22 @@ TEST(Segments, MaskModeIsExactThroughEveryIntensityStructure) {
         ro.keep_float = ro.count_samples = true;
         ro.ert = rng.coin() ? 0.99f : 2.f;
         const Camera cam = random_camera(inten, rng, 30);
-        const RenderResult ref = seg.render(cam, ro);
-        for (AccelKind k : all_accel_kinds()) {
-            if (k == AccelKind::None) continue;
-            auto accel = make_accel(k, inten);
-            accel->set_transfer_function(lut);
-            seg.set_accel(accel.get());
-            const RenderResult r = seg.render(cam, ro);
-            seg.set_accel(nullptr);
-            expect_same(r, ref, "trial " + std::to_string(trial) + " accel " + to_string(k));
-            ASSERT_LE(r.stats.samples, ref.stats.samples) << to_string(k);
+        for (Interpolation interp : {Interpolation::Trilinear, Interpolation::Nearest}) {
+            ro.interpolation = interp;
+            const RenderResult ref = seg.render(cam, ro);
+            for (AccelKind k : all_accel_kinds()) {
+                if (k == AccelKind::None) continue;
+                AccelOptions ao;
+                ao.interpolation = interp;  // nearest: bitfield and grid keep sets with holes
+                auto accel = make_accel(k, inten, ao);
+                accel->set_transfer_function(lut);
+                seg.set_accel(accel.get());
+                const RenderResult r = seg.render(cam, ro);
+                seg.set_accel(nullptr);
+                expect_same(r, ref, "trial " + std::to_string(trial) + " accel " + to_string(k) +
+                                        " " + to_string(interp));
+                ASSERT_LE(r.stats.samples, ref.stats.samples) << to_string(k);
+            }
         }
     }
 }
@@ -212,6 +218,9 @@ TEST(Segments, MaskWithEveryLabelVisibleIsTheRayMarcherToTheBit) {
         ro.ert = rng.coin() ? 0.99f : 2.f;
         const Camera cam = random_camera(inten, rng, 32);
         expect_same(seg.render(cam, ro), m.render(cam, ro), "trial " + std::to_string(trial));
+        ro.interpolation = Interpolation::Nearest;
+        const RenderResult sn = seg.render(cam, ro), mn = m.render(cam, ro);
+        expect_same(sn, mn, "trial " + std::to_string(trial) + " nearest");
     }
 }
 

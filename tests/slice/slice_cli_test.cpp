@@ -49,6 +49,27 @@ TEST(SliceCli, EveryBoxSourceAndThresholdOneWriteTheBasicBytes) {
     }
 }
 
+// Nearest samples: every box source (built from cell ranges, exact for nearest too) still writes
+// the bytes of the slicer without boxes, and the picture differs from the trilinear one.
+TEST(SliceCli, NearestSamplesAreExactForEveryBoxSource) {
+    const std::string v = volume().string();
+    const fs::path ref = temp_dir() / "basic-nearest.png", tri = temp_dir() / "basic-tri.png";
+    CliRun r = run("render " + v + " --tf mr-default --size 40 --renderer slice --interpolation nearest --out " +
+                   ref.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("render " + v + " --tf mr-default --size 40 --renderer slice --out " + tri.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(slurp(ref), slurp(tri));
+    for (const std::string extra : {"--accel kdtree", "--accel boxes",
+                                    "--accel kdtree --occlusion --occlusion-threshold 1"}) {
+        const fs::path png = temp_dir() / "xn.png";
+        r = run("render " + v + " --tf mr-default --size 40 --renderer slice --interpolation nearest " +
+                extra + " --out " + png.string());
+        ASSERT_EQ(r.code, 0) << extra << ": " << r.err;
+        EXPECT_EQ(slurp(png), slurp(ref)) << extra;
+    }
+}
+
 TEST(SliceCli, InvalidCombinationsAreOneLineExit2) {
     const std::string v = volume().string();
     const std::string base = "render " + v + " --tf mr-default --size 16 ";
