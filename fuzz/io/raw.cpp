@@ -19,8 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     std::string name;
     for (char c : lines[0])
-        if (name.size() < 80 && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
-                                 c == '.' || c == '-'))
+        if (name.size() < 80 &&
+            (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-'))
             name += c;
     if (name.empty() || name[0] == '.') name = "v" + name;
     if (name.size() < 4 || name.compare(name.size() - 4, 4, ".raw") != 0) name += ".raw";

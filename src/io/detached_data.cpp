@@ -44,16 +44,16 @@ void check_data_file(const std::string& header, const std::string& field, const 
     struct stat st {};
     if (::stat(p.c_str(), &st) != 0)
         throw Error(header, field, shown + ": " + std::strerror(errno));
-    if (!S_ISREG(st.st_mode))
-        throw Error(header, field, shown + " is not a regular file");
+    if (!S_ISREG(st.st_mode)) throw Error(header, field, shown + " is not a regular file");
     if (allow_external) return;
     std::error_code ec1, ec2;
     const fs::path real = fs::canonical(p, ec1), real_dir = fs::canonical(dir, ec2);
     if (ec1 || ec2) throw Error(header, field, shown + ": cannot resolve its path");
     if (!is_below(real, real_dir))
         throw Error(header, field,
-                    shown + " is outside the header's folder (allow it with the external-data "
-                            "option)");
+                    shown +
+                        " is outside the header's folder (allow it with the external-data "
+                        "option)");
 }
 
 void check_nrrd_data_files(const std::string& header, bool allow_external) {
@@ -97,8 +97,8 @@ void check_nrrd_data_files(const std::string& header, bool allow_external) {
             std::sscanf(w[1].c_str(), "%lld", &lo) != 1 ||
             std::sscanf(w[2].c_str(), "%lld", &hi) != 1 ||
             std::sscanf(w[3].c_str(), "%lld", &step) != 1 || step == 0 || lo < -kBound ||
-            lo > kBound || hi < -kBound || hi > kBound ||
-            (hi - lo) / step < 0 || (hi - lo) / step > kMaxDim)
+            lo > kBound || hi < -kBound || hi > kBound || (hi - lo) / step < 0 ||
+            (hi - lo) / step > kMaxDim)
             throw Error(header, field,
                         "expected '<name with one %d> <min> <max> <step>', got '" +
                             one_line(spec, 120) + "'");

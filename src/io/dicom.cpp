@@ -28,11 +28,11 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <random>
@@ -79,8 +79,9 @@ void check_folder_entries(const std::string& dir) {
             throw Error(dir, name, std::string("cannot read: ") + std::strerror(errno));
         }
         if (S_ISDIR(st.st_mode) || S_ISREG(st.st_mode)) continue;
-        throw Error(dir, name, std::string("is ") + kind_of(st.st_mode) +
-                                   ", expected only DICOM slice files in the folder");
+        throw Error(dir, name,
+                    std::string("is ") + kind_of(st.st_mode) +
+                        ", expected only DICOM slice files in the folder");
     }
     if (ec) throw Error(dir, "DICOM series", "cannot list the folder: " + ec.message());
 }
@@ -143,7 +144,8 @@ SliceInfo read_slice_info(itk::GDCMImageIO& io, const std::string& file, const s
         for (unsigned r = 0; r < 3 && r < col.size(); ++r) s.direction[r * 3 + a] = col[r];
     }
     std::string text;
-    s.has_position = itk::ExposeMetaData<std::string>(io.GetMetaDataDictionary(), "0020|0032", text);
+    s.has_position =
+        itk::ExposeMetaData<std::string>(io.GetMetaDataDictionary(), "0020|0032", text);
     if (itk::ExposeMetaData<std::string>(io.GetMetaDataDictionary(), "0028|0100", text))
         s.bits_allocated = std::atoi(text.c_str());
     return s;
@@ -153,8 +155,8 @@ SliceInfo read_slice_info(itk::GDCMImageIO& io, const std::string& file, const s
 // walked length (dicom_check.h) with what rows x columns x frames x BitsAllocated need.
 void check_pixel_length(const SliceInfo& s, const DicomWalk& w, const std::string& file,
                         const std::string& dir) {
-    if (w.pixel_data_length < 0 || (s.bits_allocated != 8 && s.bits_allocated != 16 &&
-                                    s.bits_allocated != 32))
+    if (w.pixel_data_length < 0 ||
+        (s.bits_allocated != 8 && s.bits_allocated != 16 && s.bits_allocated != 32))
         return;
     const uint64_t need = uint64_t(s.nx) * s.ny * s.nz * uint64_t(s.bits_allocated / 8);
     if (uint64_t(w.pixel_data_length) < need)
@@ -330,7 +332,8 @@ void read_series_child(const std::string& dir, const MemoryBudget& budget, int m
     const bool multi_frame = files.size() == 1;
     if (!multi_frame && first.nz != 1)
         throw Error(dir, "DICOM series", "mixes multi-frame files into a slice series");
-    const unsigned nz = multi_frame ? first.nz : unsigned(std::min<size_t>(files.size(), UINT32_MAX));
+    const unsigned nz =
+        multi_frame ? first.nz : unsigned(std::min<size_t>(files.size(), UINT32_MAX));
     if (first.nx < 2 || first.ny < 2 || nz < 2 || first.nx > unsigned(kMaxDim) ||
         first.ny > unsigned(kMaxDim) || nz > unsigned(kMaxDim))
         throw Error(dir, "dims",
@@ -347,7 +350,8 @@ void read_series_child(const std::string& dir, const MemoryBudget& budget, int m
     ch.limit_memory(sat_add(sat_add(bytes, 4 * slice_stage), kChildSlack));
 
     if (::ftruncate(memfd, off_t(bytes)) != 0)
-        throw Error(dir, "memory", std::string("cannot allocate the volume: ") + std::strerror(errno));
+        throw Error(dir, "memory",
+                    std::string("cannot allocate the volume: ") + std::strerror(errno));
     void* data = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, memfd, 0);
     if (data == MAP_FAILED)
         throw Error(dir, "memory", std::string("cannot map the volume: ") + std::strerror(errno));
@@ -410,7 +414,8 @@ Volume read_dicom_dir(const std::string& dir, const ReadOptions& opts) {
     check_folder_entries(dir);
     const int memfd = ::memfd_create("lacuna-dicom", MFD_CLOEXEC);
     if (memfd < 0)
-        throw Error(dir, "memory", std::string("cannot create shared memory: ") + std::strerror(errno));
+        throw Error(dir, "memory",
+                    std::string("cannot create shared memory: ") + std::strerror(errno));
     struct FdCloser {
         int fd;
         ~FdCloser() { ::close(fd); }
@@ -516,7 +521,8 @@ void write_slices_child(const std::string& dir, const std::string& where, const 
         try {
             io->Write(static_cast<const uint8_t*>(v.data()) + size_t(k) * slice_bytes);
         } catch (const std::exception& e) {
-            throw Error(where, "output", "cannot write " + std::string(name) + ": " + itk_message(e));
+            throw Error(where, "output",
+                        "cannot write " + std::string(name) + ": " + itk_message(e));
         }
         // GDCM may not notice a short write: every slice holds at least its voxels.
         expect_file_size(file, slice_bytes, where, true);
@@ -537,7 +543,8 @@ void write_dicom_dir(const std::string& dir, const Volume& v) {
     while (target.size() > 1 && target.back() == '/') target.pop_back();
     std::error_code ec;
     if (fs::exists(target, ec) && !(fs::is_directory(target, ec) && fs::is_empty(target, ec)))
-        throw Error(dir, "output", "exists and is not an empty folder; DICOM output needs a new one");
+        throw Error(dir, "output",
+                    "exists and is not an empty folder; DICOM output needs a new one");
     check_writable_dir(target);
     const TempName tmp = temp_name_beside(target);
     remove_stale_temp_files(tmp.dir);

@@ -13,8 +13,8 @@ namespace {
 
 // VRs whose explicit form has 2 reserved bytes and a 4-byte length (PS3.5 Section 7.1.2).
 bool long_vr(const char* vr) {
-    static const char* kLong[] = {"OB", "OD", "OF", "OL", "OV", "OW", "SQ", "SV", "UC", "UN",
-                                  "UR", "UT", "UV"};
+    static const char* kLong[] = {"OB", "OD", "OF", "OL", "OV", "OW", "SQ",
+                                  "SV", "UC", "UN", "UR", "UT", "UV"};
     for (const char* v : kLong)
         if (vr[0] == v[0] && vr[1] == v[1]) return true;
     return false;
@@ -60,7 +60,8 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
         if (in_meta && g0 != 0x0002) {
             // The meta group ended: switch to the data set's transfer syntax (PS3.5 Annex A).
             in_meta = false;
-            while (!syntax.empty() && (syntax.back() == '\0' || syntax.back() == ' ')) syntax.pop_back();
+            while (!syntax.empty() && (syntax.back() == '\0' || syntax.back() == ' '))
+                syntax.pop_back();
             explicit_vr = syntax != "1.2.840.10008.1.2";
             big = syntax == "1.2.840.10008.1.2.2";
             if (syntax == "1.2.840.10008.1.2.1.99") return w;  // deflated: not walkable
@@ -68,7 +69,8 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
         const uint16_t g = u16(h, big), e = u16(h + 2, big);
         uint64_t len = 0, head = 8;
         const char vr[2] = {char(h[4]), char(h[5])};
-        const bool has_vr = explicit_vr && vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z';
+        const bool has_vr =
+            explicit_vr && vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z';
         if (g == 0xFFFE) return w;  // item tags at top level: leave to GDCM
         if (has_vr && long_vr(vr)) {
             in.read(reinterpret_cast<char*>(h + 8), 4);

@@ -15,8 +15,8 @@
 namespace lacuna::io {
 
 struct DicomWalk {
-    bool part10 = false;               // "DICM" at byte 128
-    int64_t pixel_data_length = -1;    // defined length of (7FE0,0010), -1 if not reached
+    bool part10 = false;             // "DICM" at byte 128
+    int64_t pixel_data_length = -1;  // defined length of (7FE0,0010), -1 if not reached
 };
 
 // Throws Error(dir, <file name>, "element (gggg,eeee) says N bytes, M are left in the file

@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cinttypes>
 #include <cerrno>
+#include <cinttypes>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -78,8 +78,8 @@ void check_budget(const std::string& where, const std::string& field, const std:
     const uint64_t limit = budget.bytes ? budget.bytes : default_memory_budget();
     if (need <= limit) return;
     throw Error(where, field,
-                what + " needs " + (need == UINT64_MAX ? std::string("more than 18 EB")
-                                                       : format_bytes(need)) +
+                what + " needs " +
+                    (need == UINT64_MAX ? std::string("more than 18 EB") : format_bytes(need)) +
                     ", more than " + budget.name + " " + format_bytes(limit));
 }
 
@@ -195,7 +195,8 @@ void sync_file(const std::string& path, const std::string& where) {
         if (::fsync(fd) != 0) err = errno;
         if (::close(fd) != 0 && !err) err = errno;
     }
-    if (err) throw Error(where, "output", std::string("cannot write: fsync: ") + std::strerror(err));
+    if (err)
+        throw Error(where, "output", std::string("cannot write: fsync: ") + std::strerror(err));
 }
 
 void sync_dir(const std::string& dir) noexcept {

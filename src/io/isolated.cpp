@@ -178,7 +178,8 @@ void run_isolated(const std::string& where, const std::string& field, const std:
     ::close(fds[0]);
     const int status = reap(false);
     if (have_error) throw Error(error);
-    const std::string on = file.empty() ? "" : " on " + std::filesystem::path(file).filename().string();
+    const std::string on =
+        file.empty() ? "" : " on " + std::filesystem::path(file).filename().string();
     if (WIFSIGNALED(status))
         throw Error(where, field,
                     who + " died (" + signal_text(WTERMSIG(status)) + ")" + on +

@@ -137,8 +137,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
         MetaImage* mi = mio->GetMetaImagePointer();
         meta = metaimage_layout(path, mi->ElementDataFileName(), mi->HeaderSize(),
                                 mi->CompressedData(), mi->BinaryData(),
-                                mi->BinaryDataByteOrderMSB(), data_bytes,
-                                opts.allow_external_data);
+                                mi->BinaryDataByteOrderMSB(), data_bytes, opts.allow_external_data);
     } else if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
         const bool big = io->GetByteOrder() == itk::IOByteOrderEnum::BigEndian;
         meta = nrrd_layout(path, data_bytes, voxels,

@@ -382,8 +382,8 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     const VoxelType type = rescale ? VoxelType::Float32 : stored_type(disk);
     // dims are 2..kMaxDim each, so these products fit; sat_add guards a wild vox_offset.
     const uint64_t data_bytes = grid_bytes(dims, disk_type_size(disk));
-    check_budget(path, "dims", dims_string(dims) + " " + to_string(type), grid_bytes(dims, voxel_size(type)),
-                 opts.max_memory);
+    check_budget(path, "dims", dims_string(dims) + " " + to_string(type),
+                 grid_bytes(dims, voxel_size(type)), opts.max_memory);
 
     // An uncompressed file's length is known: report truncation before allocating. A
     // compressed one is inflated incrementally into the buffer, whose pages are only touched

@@ -44,10 +44,14 @@ NrrdFields parse_fields(const std::string& header) {
         if (line[0] == '#' || colon == std::string::npos) continue;
         const std::string key = trim(line.substr(0, colon));
         const std::string value = trim(line.substr(colon + 1));
-        if (key == "encoding") f.encoding = to_lower(value);
-        else if (key == "data file" || key == "datafile") f.data_file = value;
-        else if (key == "byte skip" || key == "byteskip") f.byte_skip = std::atoll(value.c_str());
-        else if (key == "line skip" || key == "lineskip") f.line_skip = std::atoll(value.c_str());
+        if (key == "encoding")
+            f.encoding = to_lower(value);
+        else if (key == "data file" || key == "datafile")
+            f.data_file = value;
+        else if (key == "byte skip" || key == "byteskip")
+            f.byte_skip = std::atoll(value.c_str());
+        else if (key == "line skip" || key == "lineskip")
+            f.line_skip = std::atoll(value.c_str());
     }
     f.header_end = pos;
     return f;
@@ -121,8 +125,8 @@ std::optional<MetaDataLayout> nrrd_layout(const std::string& header, uint64_t da
         if (size < data_bytes) throw truncated(header, data_bytes, size, what);
         l.offset = int64_t(size - data_bytes);
     } else if (f.byte_skip < 0) {
-        throw Error(header, "byte skip", "expected -1 or a byte count >= 0, got " +
-                                             std::to_string(f.byte_skip));
+        throw Error(header, "byte skip",
+                    "expected -1 or a byte count >= 0, got " + std::to_string(f.byte_skip));
     } else if (raw) {
         l.offset = int64_t(sat_add(uint64_t(l.offset), uint64_t(f.byte_skip)));
     }

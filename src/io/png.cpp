@@ -124,7 +124,7 @@ void write_png(const std::string& path, const Image& img) {
     if (!fp) throw Error(path, "output", std::string("cannot write: ") + std::strerror(errno));
     PngMessage msg;
     const int rc = encode_png(fp, img, msg);
-    const int flush_errno = std::fflush(fp) != 0                 ? errno
+    const int flush_errno = std::fflush(fp) != 0                    ? errno
                             : rc == 0 && ::fsync(::fileno(fp)) != 0 ? errno
                                                                     : 0;
     const bool io_error = std::ferror(fp) != 0;

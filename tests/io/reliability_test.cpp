@@ -39,7 +39,8 @@ uint64_t status_kb(const char* key) {
     std::ifstream in("/proc/self/status");
     std::string line;
     while (std::getline(in, line))
-        if (line.rfind(key, 0) == 0) return std::strtoull(line.c_str() + std::strlen(key), nullptr, 10);
+        if (line.rfind(key, 0) == 0)
+            return std::strtoull(line.c_str() + std::strlen(key), nullptr, 10);
     return 0;
 }
 
@@ -111,7 +112,8 @@ TEST(IoBudget, EveryReaderChecksTheBudgetBeforeAllocating) {
 // 200-byte header): NRRD raw and gzip data are read by our code now, incrementally.
 TEST(IoBudget, TinyNrrdClaimingAHugeVolumeFailsWithoutTouchingMemory) {
     ScratchDir dir;
-    const std::string head = "NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 3\nendian: little\n";
+    const std::string head =
+        "NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 3\nendian: little\n";
     test::write_text(dir.file("raw.nrrd"), head + "encoding: raw\n\n" + std::string(1920, '\1'));
     test::write_text(dir.file("d.nhdr"), head + "encoding: raw\ndata file: d.raw\n\n");
     test::write_bytes(dir.file("d.raw"), std::vector<uint8_t>(1920, 1));
@@ -151,16 +153,19 @@ TEST(IoNrrdData, SkipsAndByteOrdersReadExactly) {
     test::write_text(dir.file("skip.nrrd"), with("encoding: raw\nbyte skip: 5\n", "12345", ""));
     test::write_text(dir.file("lines.nrrd"), with("encoding: raw\nline skip: 2\n", "a\nbb\n", ""));
     test::write_text(dir.file("d.raw"), std::string("xyz") + std::string(vox.begin(), vox.end()));
-    test::write_text(dir.file("end.nhdr"), head + "encoding: raw\ndata file: d.raw\nbyte skip: -1\n\n");
+    test::write_text(dir.file("end.nhdr"),
+                     head + "encoding: raw\ndata file: d.raw\nbyte skip: -1\n\n");
     test::write_bytes(dir.file("d.raw.gz"), test::gzip(vox));
     test::write_text(dir.file("gz.nhdr"), head + "encoding: gzip\ndata file: d.raw.gz\n\n");
     for (const char* name : {"skip.nrrd", "lines.nrrd", "end.nhdr", "gz.nhdr"}) {
         SCOPED_TRACE(name);
         const Volume v = read_volume(dir.file(name));
         ASSERT_EQ(v.type(), VoxelType::Int16);
-        for (size_t i = 0; i < v.voxel_count(); ++i) EXPECT_EQ(v.data_as<int16_t>()[i], 100 + 2 * i);
+        for (size_t i = 0; i < v.voxel_count(); ++i)
+            EXPECT_EQ(v.data_as<int16_t>()[i], 100 + 2 * i);
     }
-    test::write_text(dir.file("short.nrrd"), with("encoding: raw\nbyte skip: 5\n", "1234", "").substr(0, 120));
+    test::write_text(dir.file("short.nrrd"),
+                     with("encoding: raw\nbyte skip: 5\n", "1234", "").substr(0, 120));
     EXPECT_NE(read_error(dir.file("short.nrrd")).find("truncated"), std::string::npos);
 }
 
@@ -188,9 +193,11 @@ TEST(IoBudget, WildNifti2OffsetsDoNotOverflow) {
 TEST(IoBudget, CliTakesMaxMemoryAndNamesIt) {
     ScratchDir dir;
     test::write_bytes(dir.file("claim.nii.gz"), huge_claim_nii_gz());
-    const auto r = test::run_cli("info " + dir.file("claim.nii.gz") + " --max-memory 2G", dir.path());
+    const auto r =
+        test::run_cli("info " + dir.file("claim.nii.gz") + " --max-memory 2G", dir.path());
     test::expect_one_line_error(r, "needs 5.4 GB, more than --max-memory 2.0 GB");
-    const auto bad = test::run_cli("info " + dir.file("claim.nii.gz") + " --max-memory lots", dir.path());
+    const auto bad =
+        test::run_cli("info " + dir.file("claim.nii.gz") + " --max-memory lots", dir.path());
     test::expect_one_line_error(bad, "--max-memory: size: expected a size like 12G");
 }
 
@@ -198,25 +205,29 @@ TEST(IoBudget, CliTakesMaxMemoryAndNamesIt) {
 // Detached headers
 
 std::string nhdr(const std::string& data_line) {
-    return "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n" + data_line + "\n\n";
+    return "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n" + data_line +
+           "\n\n";
 }
 std::string mhd(const std::string& data) {
     return "ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\n"
-           "ElementDataFile = " + data + "\n";
+           "ElementDataFile = " +
+           data + "\n";
 }
 
 // MetaIO strcpy()s header fields into char[255]: a 256-character key or value aborted the
 // process (glibc's fortify check; found by fuzz_metaimage).
 TEST(IoMetaImage, OverlongHeaderFieldsAreErrorsNotAborts) {
     ScratchDir dir;
-    const std::string head = "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n";
+    const std::string head =
+        "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n";
     const std::string tail = "ElementDataFile = LOCAL\n" + std::string(8, '\0');
     test::write_text(dir.file("key.mha"), head + std::string(256, 'K') + " = 1\n" + tail);
     test::write_text(dir.file("name.mha"), head + "Name = " + std::string(300, 'x') + "\n" + tail);
     test::write_text(dir.file("ok.mha"), head + "Name = " + std::string(254, 'x') + "\n" + tail);
     EXPECT_NE(read_error(dir.file("key.mha")).find("line 5 has a key of 256 characters"),
               std::string::npos);
-    EXPECT_NE(read_error(dir.file("name.mha")).find("a value of 300 characters"), std::string::npos);
+    EXPECT_NE(read_error(dir.file("name.mha")).find("a value of 300 characters"),
+              std::string::npos);
     EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
     test::write_text(dir.file("endless.mha"), head + std::string(size_t(1) << 20, '\n'));
     EXPECT_NE(read_error(dir.file("endless.mha")).find("no ElementDataFile"), std::string::npos);
@@ -237,7 +248,8 @@ TEST(IoDetached, DataFileOutsideTheHeadersFolderNeedsPermission) {
     allow.allow_external_data = true;
     for (const char* h : {"h/a.nhdr", "h/a.mhd", "h/b.nhdr", "h/b.mhd", "h/c.nhdr"}) {
         SCOPED_TRACE(h);
-        EXPECT_NE(read_error(dir.file(h)).find("is outside the header's folder"), std::string::npos);
+        EXPECT_NE(read_error(dir.file(h)).find("is outside the header's folder"),
+                  std::string::npos);
         const Volume v = read_volume(dir.file(h), allow);
         EXPECT_EQ(v.data_as<uint8_t>()[63], 7);
     }
@@ -280,7 +292,8 @@ TEST(IoDetached, NrrdListsAndPatternsAreCheckedFileByFile) {
     EXPECT_EQ(read_volume(dir.file("pattern.nhdr")).data_as<uint8_t>()[63], 3);
     test::write_text(dir.file("list.nhdr"),
                      sizes + "data file: LIST 2\n\ns0.raw\ns1.raw\ns2.raw\n/etc/passwd\n");
-    EXPECT_NE(read_error(dir.file("list.nhdr")).find("'/etc/passwd' is outside"), std::string::npos);
+    EXPECT_NE(read_error(dir.file("list.nhdr")).find("'/etc/passwd' is outside"),
+              std::string::npos);
     test::write_text(dir.file("fmt.nhdr"), sizes + "data file: %s%n.raw 0 3 1 2\n\n");
     EXPECT_NE(read_error(dir.file("fmt.nhdr")).find("one %d"), std::string::npos);
     test::write_text(dir.file("mhdlist.mhd"), mhd("LIST"));
@@ -316,8 +329,8 @@ int with_file_size_limit(rlim_t limit, const std::string& name, const std::funct
 
 TEST(IoWriterFullDisk, EveryWriterFailsAndLeavesNothing) {
     const Volume v = test::pattern_volume({64, 64, 16}, VoxelType::Int16);  // 128 KiB
-    for (const char* name : {"v.nii", "v.nii.gz", "v.nrrd", "v.nhdr", "v.mha", "v.mhd", "v.raw",
-                             "series/"}) {
+    for (const char* name :
+         {"v.nii", "v.nii.gz", "v.nrrd", "v.nhdr", "v.mha", "v.mhd", "v.raw", "series/"}) {
         // Below a header, inside one, and below one DICOM slice (8 KiB) and the files (128 KiB).
         for (rlim_t limit : {rlim_t(0), rlim_t(300), rlim_t(5000)}) {
             SCOPED_TRACE(std::string(name) + " limit " + std::to_string(limit));
