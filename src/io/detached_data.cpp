@@ -56,7 +56,13 @@ void check_data_file(const std::string& header, const std::string& field, const 
                         "option)");
 }
 
-void check_nrrd_data_files(const std::string& header, bool allow_external) {
+std::vector<std::string> check_nrrd_data_files(const std::string& header, bool allow_external) {
+    std::vector<std::string> checked;
+    fs::path dir = fs::path(header).parent_path();
+    const auto keep = [&](const std::string& name) {
+        check_data_file(header, "data file", name, allow_external);
+        checked.push_back((fs::path(name).is_absolute() ? fs::path(name) : dir / name).string());
+    };
     std::ifstream in(header, std::ios::binary);
     std::string line;
     std::string spec;
@@ -70,7 +76,7 @@ void check_nrrd_data_files(const std::string& header, bool allow_external) {
             if (spec.empty()) throw Error(header, "data file", "names no data file");
         }
     }
-    if (spec.empty()) return;
+    if (spec.empty()) return checked;
     const std::string field = "data file";
     std::istringstream words(spec);
     std::vector<std::string> w;
@@ -81,11 +87,11 @@ void check_nrrd_data_files(const std::string& header, bool allow_external) {
         while (std::getline(in, line) && files <= kMaxDim) {
             const std::string name = trim(line);
             if (name.empty()) continue;
-            check_data_file(header, field, name, allow_external);
+            keep(name);
             ++files;
         }
         if (files == 0) throw Error(header, field, "LIST names no data files");
-        return;
+        return checked;
     }
     if (spec.find('%') != std::string::npos) {
         // "<format> <min> <max> <step> [<subdim>]": the format may hold one %d conversion and
@@ -105,11 +111,12 @@ void check_nrrd_data_files(const std::string& header, bool allow_external) {
         for (long long i = lo; step > 0 ? i <= hi : i >= hi; i += step) {
             char name[4096];
             std::snprintf(name, sizeof name, w[0].c_str(), int(i));
-            check_data_file(header, field, name, allow_external);
+            keep(name);
         }
-        return;
+        return checked;
     }
-    check_data_file(header, field, spec, allow_external);
+    keep(spec);
+    return checked;
 }
 
 }  // namespace lacuna::io

@@ -8,6 +8,7 @@
 // rule. Both checks run before ITK or our own data reader opens anything.
 #pragma once
 #include <string>
+#include <vector>
 
 namespace lacuna::io {
 
@@ -18,7 +19,8 @@ void check_data_file(const std::string& header, const std::string& field, const 
 
 // Parses a NRRD header (.nhdr, or a .nrrd with a "data file" field) up to its blank line and
 // applies check_data_file to every data file it names: one name, "LIST" (names on the lines
-// after the header) or a "%d" pattern with min, max and step. Does nothing for attached data.
-void check_nrrd_data_files(const std::string& header, bool allow_external);
+// after the header) or a "%d" pattern with min, max and step. Returns their paths (empty for
+// attached data).
+std::vector<std::string> check_nrrd_data_files(const std::string& header, bool allow_external);
 
 }  // namespace lacuna::io

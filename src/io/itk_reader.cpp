@@ -110,9 +110,10 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     // Our checks of the header run before ITK parses it (docs/formats.md): NDims for MetaIO,
     // and where a detached NRRD header's data files are.
     if (dynamic_cast<itk::MetaImageIO*>(io.GetPointer())) check_metaimage_header(path);
+    std::vector<std::string> nrrd_files;
     if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
         quiet.reset();
-        check_nrrd_data_files(path, opts.allow_external_data);
+        nrrd_files = check_nrrd_data_files(path, opts.allow_external_data);
         quiet.emplace();
     }
     try {
@@ -140,7 +141,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
                                 mi->BinaryDataByteOrderMSB(), data_bytes, opts.allow_external_data);
     } else if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
         const bool big = io->GetByteOrder() == itk::IOByteOrderEnum::BigEndian;
-        meta = nrrd_layout(path, data_bytes, voxels,
+        meta = nrrd_layout(path, nrrd_files, data_bytes, voxels,
                            disk_type_size(disk) > 1 && big != host_is_big_endian());
     }
     // Voxels NrrdIO reads and that need conversion pass through a full-size temporary.

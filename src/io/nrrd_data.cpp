@@ -83,8 +83,9 @@ Error truncated(const std::string& header, uint64_t need, uint64_t have, const s
 
 }  // namespace
 
-std::optional<MetaDataLayout> nrrd_layout(const std::string& header, uint64_t data_bytes,
-                                          uint64_t voxels, bool swap) {
+std::optional<MetaDataLayout> nrrd_layout(const std::string& header,
+                                          const std::vector<std::string>& data_files,
+                                          uint64_t data_bytes, uint64_t voxels, bool swap) {
     const NrrdFields f = parse_fields(header);
     const bool raw = f.encoding == "raw";
     const bool gzip = f.encoding == "gzip" || f.encoding == "gz";
@@ -99,8 +100,17 @@ std::optional<MetaDataLayout> nrrd_layout(const std::string& header, uint64_t da
     const fs::path dir = fs::path(header).parent_path();
     const bool one_file = !f.data_file.empty() && f.data_file.rfind("LIST", 0) != 0 &&
                           f.data_file.find('%') == std::string::npos;
-    // LIST or pattern (the names were checked by check_nrrd_data_files): left to NrrdIO.
-    if (!f.data_file.empty() && !one_file) return std::nullopt;
+    // LIST or pattern (the names were checked by check_nrrd_data_files): read by NrrdIO,
+    // after checking that the files together hold the raw bytes (skips make them need more).
+    if (!f.data_file.empty() && !one_file) {
+        uint64_t total = 0;
+        for (const auto& file : data_files) {
+            const uint64_t n = fs::file_size(file, ec);
+            if (!ec) total = sat_add(total, n);
+        }
+        if (raw && total < data_bytes) throw truncated(header, data_bytes, total, what);
+        return std::nullopt;
+    }
     MetaDataLayout l;
     l.swap = swap;
     l.compressed = gzip;

@@ -8,12 +8,13 @@
 // anything is allocated); type conversions go through the small staging buffer.
 //
 // Left to NrrdIO, with a length check before allocating: ascii (at least one byte per value)
-// and hex (two characters per byte) encodings, and "data file: LIST" / pattern headers (the
-// data files together must hold the bytes, for raw encoding). bzip2 data is left to NrrdIO
-// unchecked: its ratio has no useful bound.
+// and hex (two characters per byte) encodings, and "data file: LIST" / pattern headers (raw:
+// the data files together must hold the bytes). bzip2 data is left to NrrdIO unchecked: its
+// ratio has no useful bound.
 #pragma once
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "io/metaimage_data.h"
 
@@ -23,7 +24,9 @@ namespace lacuna::io {
 // one data file), nullopt otherwise. `data_bytes` is the voxel bytes the header claims; `swap`
 // whether they are in the other byte order. Throws Error(header, "voxel data", "truncated:
 // ...") when raw (or ascii/hex) data is shorter than that, before anything is allocated.
-std::optional<MetaDataLayout> nrrd_layout(const std::string& header, uint64_t data_bytes,
-                                          uint64_t voxels, bool swap);
+// `data_files` are the data files check_nrrd_data_files found (empty: attached data).
+std::optional<MetaDataLayout> nrrd_layout(const std::string& header,
+                                          const std::vector<std::string>& data_files,
+                                          uint64_t data_bytes, uint64_t voxels, bool swap);
 
 }  // namespace lacuna::io

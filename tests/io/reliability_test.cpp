@@ -296,6 +296,12 @@ TEST(IoDetached, NrrdListsAndPatternsAreCheckedFileByFile) {
               std::string::npos);
     test::write_text(dir.file("fmt.nhdr"), sizes + "data file: %s%n.raw 0 3 1 2\n\n");
     EXPECT_NE(read_error(dir.file("fmt.nhdr")).find("one %d"), std::string::npos);
+    // A list claiming far more than its files hold fails before NrrdIO allocates.
+    test::write_text(dir.file("claim.nhdr"),
+                     "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 30000 30000 4\nencoding: "
+                     "raw\ndata file: s%d.raw 0 3 1 2\n\n");
+    EXPECT_NE(read_error(dir.file("claim.nhdr")).find("truncated: expected 3600000000 bytes"),
+              std::string::npos);
     test::write_text(dir.file("mhdlist.mhd"), mhd("LIST"));
     EXPECT_NE(read_error(dir.file("mhdlist.mhd")).find("ElementDataFile"), std::string::npos);
 }
