@@ -246,6 +246,7 @@ std::string frame_header(const FrameInfo& f) {
            {"width", f.width},
            {"height", f.height},
            {"preview", f.preview},
+           {"reduced", f.reduced},
            {"renderer", f.renderer},
            {"accel", f.accel},
            {"frame_ms", f.frame_ms},

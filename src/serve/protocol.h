@@ -88,6 +88,7 @@ struct FrameInfo {
     uint64_t id = 0;
     int width = 0, height = 0;  // of the JPEG (reduced when preview)
     bool preview = false;
+    int reduced = 1;  // the render budget divided each side by this (1: not reduced)
     std::string renderer, accel;
     double frame_ms = 0;   // the render alone
     double encode_ms = 0;  // JPEG

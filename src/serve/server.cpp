@@ -7,7 +7,9 @@
 #include "serve/server.h"
 
 #include <algorithm>
+#include <atomic>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -17,6 +19,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -34,6 +37,7 @@ namespace websocket = beast::websocket;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
 
 namespace {
 
@@ -50,6 +54,13 @@ std::string host_name(std::string_view host_header) {
     }
     const size_t colon = h.find(':');
     return colon == std::string::npos ? h : h.substr(0, colon);
+}
+
+// What the time per pixel of a frame depends on most (the render budget's estimate is kept
+// per key).
+std::string cost_key(const ViewRequest& r) {
+    return to_string(r.renderer) + "/" + to_string(r.accel) + (r.shading ? "/shading" : "") +
+           (r.clip ? "/clip" : "") + (r.segments ? "/segments" : "");
 }
 
 bool is_loopback_name(const std::string& h) {
@@ -78,6 +89,11 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     // Network thread only.
     std::set<std::shared_ptr<WsSession>> sessions;
     bool stopping = false;
+    net::steady_timer accept_timer{ioc};
+    std::chrono::milliseconds accept_backoff{0};
+
+    std::atomic<uint64_t> accept_errors{0}, idle_closed{0}, evicted{0}, budget_reduced{0},
+        dropped{0};
 
     // The render thread and its latest-wins slots (guarded by slot_mutex).
     std::mutex slot_mutex;
@@ -86,11 +102,15 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     bool render_stop = false;
     std::thread render_thread;
     double last_full_ms = 0;  // render thread only: drives the preview's reduction
+    // Render thread only: milliseconds per pixel-sample-step unit (w * h / step) of the last
+    // frame of each cost_key, the render budget's estimate.
+    std::map<std::string, double> ms_per_unit;
 
     std::once_flag stop_once;
 
     void accept();
     void on_accept(beast::error_code ec, tcp::socket socket);
+    bool evict_idlest();
     void submit(const std::shared_ptr<WsSession>& s);
     void render_loop();
     void close_all();
@@ -105,7 +125,14 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
     template <class Body, class Allocator>
     void run(http::request<Body, http::basic_fields<Allocator>> req) {
-        m_ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+        // Beast closes the stream when nothing arrives for idle_timeout; no keep-alive pings, so
+        // only the page's own messages count as activity.
+        auto timeout = websocket::stream_base::timeout::suggested(beast::role_type::server);
+        const auto idle = m_server->options.idle_timeout;
+        timeout.idle_timeout =
+            idle.count() > 0 ? Clock::duration(idle) : websocket::stream_base::none();
+        timeout.keep_alive_pings = false;
+        m_ws.set_option(timeout);
         m_ws.read_message_max(m_server->options.max_frame_bytes);
         m_ws.async_accept(req,
                           beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
@@ -126,6 +153,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         beast::get_lowest_layer(m_ws).socket().shutdown(tcp::socket::shutdown_both, ec);
         beast::get_lowest_layer(m_ws).socket().close(ec);
     }
+    // Closed to make room for a new tab: leaves the session set now.
+    void evict() {
+        close();
+        finish();
+    }
+    Clock::time_point last_active() const { return m_last_active; }
 
     // The latest-wins slot, shared with the render thread (Impl::slot_mutex).
     std::optional<ViewRequest> pending;
@@ -149,7 +182,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     }
 
     void on_read(beast::error_code ec, size_t) {
+        if (ec == beast::error::timeout) ++m_server->idle_closed;
         if (ec) return finish();
+        m_last_active = Clock::now();
         const std::string text = beast::buffers_to_string(m_buffer.data());
         m_buffer.consume(m_buffer.size());
         if (!m_ws.got_text()) {
@@ -171,6 +206,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     }
 
     void finish() {
+        {
+            // A closed tab's queued request is not rendered.
+            std::lock_guard<std::mutex> lock(m_server->slot_mutex);
+            if (pending) ++m_server->dropped;
+            pending.reset();
+        }
         if (m_server->sessions.erase(shared_from_this()) && m_server->options.log)
             std::printf("viewer: tab closed (%zu open)\n", m_server->sessions.size());
     }
@@ -206,7 +247,23 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     std::optional<std::string> m_frame;
     std::string m_out;  // the message being written (alive until on_write)
     bool m_writing = false;
+    Clock::time_point m_last_active = Clock::now();  // connect, then the last message read
 };
+
+// A full server admits a new tab by closing the one idle longest, if it has been idle for
+// evict_idle_after. True if a slot was freed.
+bool Server::Impl::evict_idlest() {
+    if (sessions.empty()) return false;
+    const auto idlest = std::min_element(
+        sessions.begin(), sessions.end(),
+        [](const auto& a, const auto& b) { return a->last_active() < b->last_active(); });
+    if (Clock::now() - (*idlest)->last_active() < options.evict_idle_after) return false;
+    const std::shared_ptr<WsSession> s = *idlest;
+    s->evict();
+    ++evicted;
+    if (options.log) std::printf("viewer: closed the longest-idle tab for a new one\n");
+    return true;
+}
 
 // One HTTP connection: GET/HEAD of an embedded asset, or the upgrade to /ws.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
@@ -249,7 +306,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
             if (!origin.empty() && origin != "http://" + host)
                 return respond(
                     plain(http::status::forbidden, "forbidden origin\n", req.version(), false));
-            if (int(m_server->sessions.size()) >= m_server->options.max_sessions)
+            if (int(m_server->sessions.size()) >= m_server->options.max_sessions &&
+                !m_server->evict_idlest())
                 return respond(plain(http::status::service_unavailable, "too many tabs\n",
                                      req.version(), false));
             beast::get_lowest_layer(m_stream).expires_never();
@@ -327,6 +385,20 @@ void Server::Impl::accept() {
 
 void Server::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
     if (stopping || !acceptor.is_open()) return;
+    if (ec && ec != net::error::connection_aborted) {
+        // Out of file descriptors (EMFILE, ENFILE), buffers or memory: the connection waits in
+        // the backlog, so accepting again at once fails again, a busy loop that starves every
+        // open socket. Back off, doubling from 10 ms to 1 s, until an accept succeeds.
+        ++accept_errors;
+        accept_backoff = std::clamp(accept_backoff * 2, std::chrono::milliseconds(10),
+                                    std::chrono::milliseconds(1000));
+        accept_timer.expires_after(accept_backoff);
+        accept_timer.async_wait([self = shared_from_this()](beast::error_code e) {
+            if (!e && !self->stopping) self->accept();
+        });
+        return;
+    }
+    accept_backoff = 0ms;
     if (!ec) std::make_shared<HttpSession>(std::move(socket), shared_from_this())->run();
     accept();
 }
@@ -368,15 +440,37 @@ void Server::Impl::render_loop() {
             // judged by the last full-resolution frame: 1/2, 1/3 or 1/4 per side.
             int div = 1;
             if (req.preview) div = std::clamp(int(std::ceil(std::sqrt(last_full_ms / 33.0))), 2, 4);
-            const int w = std::max(1, req.width / div), h = std::max(1, req.height / div);
+            int w = std::max(1, req.width / div), h = std::max(1, req.height / div);
+            // The render budget: the estimate is the last frame of the same key per unit (its
+            // own, else the slowest known: a first frame of a new structure is not cheaper), and
+            // an estimate over budget divides each side by up to 8.
+            const std::string key = cost_key(req);
+            int reduced = 1;
+            if (options.render_budget_ms > 0 && !ms_per_unit.empty()) {
+                double rate = 0;
+                if (auto it = ms_per_unit.find(key); it != ms_per_unit.end())
+                    rate = it->second;
+                else
+                    for (const auto& [k, r] : ms_per_unit) rate = std::max(rate, r);
+                const double estimate = rate * double(w) * double(h) / double(req.step);
+                if (estimate > options.render_budget_ms) {
+                    reduced = std::clamp(
+                        int(std::ceil(std::sqrt(estimate / options.render_budget_ms))), 2, 8);
+                    w = std::max(1, w / reduced);
+                    h = std::max(1, h / reduced);
+                    ++budget_reduced;
+                }
+            }
             const Clock::time_point start = Clock::now();
             Frame f = renderer.render(req, w, h);
+            ms_per_unit[key] = f.stats.seconds * 1e3 * double(req.step) / (double(w) * double(h));
             if (!req.preview) last_full_ms = f.stats.seconds * 1e3;
             FrameInfo info;
             info.id = req.id;
             info.width = w;
             info.height = h;
             info.preview = req.preview;
+            info.reduced = reduced;
             info.renderer = to_string(req.renderer);
             info.accel = to_string(req.accel);
             info.frame_ms = f.stats.seconds * 1e3;
@@ -412,6 +506,7 @@ void Server::Impl::close_all() {
     stopping = true;
     beast::error_code ec;
     acceptor.close(ec);
+    accept_timer.cancel();
     if (signals) signals->cancel(ec);
     for (const auto& s : sessions) s->close();
     sessions.clear();
@@ -481,6 +576,16 @@ void Server::run() {
 
 void Server::stop() {
     net::post(m->ioc, [impl = m] { impl->close_all(); });
+}
+
+Server::Stats Server::stats() const {
+    Stats s;
+    s.accept_errors = m->accept_errors;
+    s.idle_closed = m->idle_closed;
+    s.evicted = m->evicted;
+    s.budget_reduced = m->budget_reduced;
+    s.dropped = m->dropped;
+    return s;
 }
 
 std::string Server::url() const {

@@ -8,11 +8,27 @@
 // stale requests are dropped instead of queued, and a finished frame that has not started
 // going out is replaced by a newer one.
 //
+// Robustness (issue 15; every limit below is a ServerOptions field):
+//   - accept errors (out of file descriptors: the connection stays in the backlog, so accepting
+//     again at once fails again) back off, doubling from 10 ms to 1 s, instead of spinning;
+//   - a WebSocket that sends nothing for idle_timeout is closed, and a full server (max_sessions
+//     open) makes room for a new tab by closing the one idle longest, if it has been idle for
+//     evict_idle_after: idle sockets cannot lock tabs out;
+//   - render budget: a request whose estimated time (the last frame of the same renderer,
+//     structure and features, per pixel and per sample step) exceeds render_budget_ms is rendered
+//     at 1/2 .. 1/8 of its size per side (the frame header says "reduced"), so one 4096² request
+//     holds the render thread for about the budget, not 24 s, while other tabs wait. A closed
+//     tab's queued request is dropped and a newer request replaces a queued one (latest wins);
+//     a frame already rendering runs to its end (the renderers have no cancellation point);
+//   - a malformed or unrenderable message is answered with an "error" message naming the field;
+//     the connection and the server stay up.
+//
 // Security: binds 127.0.0.1 unless told otherwise; serves only the page embedded in the binary
 // (no path from the browser is ever opened); on a loopback address it accepts only Host
 // headers naming loopback (DNS rebinding); the WebSocket upgrade is refused when the browser's
 // Origin is not the page's own; message size, image size and TF size are bounded.
 #pragma once
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -27,7 +43,14 @@ struct ServerOptions {
     uint16_t port = 8080;  // 0: an ephemeral port (tests)
     Limits limits;
     size_t max_frame_bytes = 1 << 20;  // WebSocket messages above this close the connection
-    int max_sessions = 32;             // open WebSockets; more are refused
+    int max_sessions = 32;             // open WebSockets; more are refused (but see eviction)
+    // A WebSocket with no message from the page for this long is closed (0: never).
+    std::chrono::milliseconds idle_timeout = std::chrono::minutes(30);
+    // When max_sessions are open, a new tab closes the longest-idle one if it has been idle at
+    // least this long (else the new tab is refused with 503).
+    std::chrono::milliseconds evict_idle_after = std::chrono::seconds(30);
+    // Estimated render time above which a frame is rendered reduced (0: no budget).
+    double render_budget_ms = 2000;
     std::string volume_name;           // shown by the page
     TransferFunction initial_tf = preset("mr-default");
     int jpeg_quality = 88;
@@ -52,6 +75,16 @@ class Server {
     // Thread-safe, idempotent: closes the listener and every connection; run() returns.
     void stop();
     std::string url() const;
+
+    // Counters since start (thread-safe): what the robustness limits did.
+    struct Stats {
+        uint64_t accept_errors = 0;   // failed accepts (each followed by a back-off)
+        uint64_t idle_closed = 0;     // WebSockets closed by idle_timeout
+        uint64_t evicted = 0;         // idle WebSockets closed to admit a new tab
+        uint64_t budget_reduced = 0;  // frames rendered reduced by the render budget
+        uint64_t dropped = 0;         // queued requests of closed tabs, not rendered
+    };
+    Stats stats() const;
 
     struct Impl;  // opaque: Beast stays out of this header
 
