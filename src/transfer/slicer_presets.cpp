@@ -109,11 +109,13 @@ std::vector<double> counted(const std::string& text, int per, const std::string&
         throw Error(where, field,
                     std::string("expected a count N and N numbers (") + layout + "), got nothing");
     const double n = v[0];
-    if (n != std::floor(n) || n < per || int64_t(n) % per != 0)
+    // Compared as doubles before any integer conversion: a count of 1e39 must not reach
+    // int64_t or size_t (UB).
+    if (!(n >= per) || n != std::floor(n) || (n <= double(v.size()) && int64_t(n) % per != 0))
         throw Error(where, field,
                     "expected a count N that is a positive multiple of " + std::to_string(per) +
                         " (" + layout + "), got " + tf_detail::double_text(n));
-    if (size_t(n) != v.size() - 1)
+    if (n != double(v.size() - 1))
         throw Error(where, field,
                     "expected " + tf_detail::double_text(n) + " numbers after the count, got " +
                         std::to_string(v.size() - 1));
@@ -497,7 +499,8 @@ std::vector<SlicerVolumeProperty> parse_slicer_vp_json(const std::string& text,
     json doc;
     try {
         doc = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
+        // parse_error, and out_of_range.406 for a number beyond double (1e999).
         std::string what = e.what();
         const size_t b = what.find("] ");
         if (b != std::string::npos) what = what.substr(b + 2);
