@@ -96,10 +96,8 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
             syntax.resize(len);
             in.read(syntax.data(), std::streamsize(len));
         }
-        if (g == 0x7FE0 && e == 0x0010) {
-            w.pixel_data_length = int64_t(len);
-            return w;
-        }
+        // Elements after Pixel Data (padding, or junk) are walked too: GDCM reads them.
+        if (g == 0x7FE0 && e == 0x0010) w.pixel_data_length = int64_t(len);
         pos += head + len;
     }
     // Bytes left over that cannot hold an element header: GDCM asserts on these

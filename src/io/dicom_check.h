@@ -5,7 +5,9 @@
 // slice silently short. This walk reads only tags and lengths (never values): the preamble,
 // "DICM", the file meta group (always explicit VR little endian), then the data set in the
 // transfer syntax the meta group names. Every element with a defined length must end inside
-// the file. The walk stops, without a verdict, at the first undefined length (a sequence or
+// the file, up to the last one (GDCM also reads what follows the Pixel Data: a 1710-byte slice
+// with a junk element after it made GDCM allocate 3.9 GB; found by fuzz_dicom_dir). The walk
+// stops, without a verdict, at the first undefined length (a sequence or
 // encapsulated pixel data, whose items GDCM parses) and for files without "DICM" (GDCM also
 // reads bare data sets; such files are left to it and to the child's memory cap).
 #pragma once

@@ -507,6 +507,22 @@ TEST(IoDicomFolder, SliceCutInsideAnElementHeaderIsAnError) {
     }
 }
 
+// A junk element after the Pixel Data with a length of 3.9 GB made GDCM's scanner allocate it
+// (found by fuzz_dicom_dir): the walk goes on past the Pixel Data.
+TEST(IoDicomFolder, HugeLengthAfterThePixelDataIsAnError) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    const std::string victim = s + "/slice_00001.dcm";
+    std::vector<uint8_t> bytes = test::file_bytes(victim);
+    const uint8_t junk[] = {0xea, 0xea, 0xea, 0xea, 0xea, 0xea, 0xea, 0xea, 1, 2, 3, 4};
+    bytes.insert(bytes.end(), std::begin(junk), std::end(junk));
+    test::write_bytes(victim, bytes);
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("slice_00001.dcm: element (EAEA,EAEA) says 3941264106 bytes, 4 are left"),
+              std::string::npos)
+        << msg;
+}
+
 TEST(IoDicomFolder, ShortPixelDataIsAnErrorNotAShortSlice) {
     ScratchDir dir;
     const std::string s = write_series(dir, "s", 3);
