@@ -183,7 +183,8 @@ void run_isolated(const std::string& where, const std::string& field, const std:
     if (WIFSIGNALED(status))
         throw Error(where, field,
                     who + " died (" + signal_text(WTERMSIG(status)) + ")" + on +
-                        ": the file is damaged or not supported");
+                        (field == "output" ? ": cannot write (disk full or file size limit?)"
+                                           : ": the file is damaged or not supported"));
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
         throw Error(where, field, who + " failed" + on);
 }

@@ -7,7 +7,9 @@
 #include <itkNrrdImageIOFactory.h>
 #include <itkObject.h>
 #include <itkOutputWindow.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <iostream>
 #include <regex>
 
@@ -123,14 +125,34 @@ itk::IOComponentEnum itk_component_of(VoxelType t) {
 
 QuietStderr::QuietStderr() : m_lock(stderr_mutex()) {
     m_saved = std::cerr.rdbuf(m_buffer.rdbuf());
+    // C-level stderr too: niftilib fprintf()s "** ERROR: NWAD: wrote only ..." on a short write.
+    std::fflush(stderr);
+    m_file = std::tmpfile();
+    m_saved_fd = m_file ? ::dup(2) : -1;
+    if (m_saved_fd >= 0) ::dup2(::fileno(m_file), 2);
 }
 
 QuietStderr::~QuietStderr() {
     std::cerr.rdbuf(m_saved);
+    std::fflush(stderr);
+    if (m_saved_fd >= 0) {
+        ::dup2(m_saved_fd, 2);
+        ::close(m_saved_fd);
+    }
+    if (m_file) std::fclose(m_file);
 }
 
 std::string QuietStderr::text() const {
-    const std::string s = m_buffer.str();
+    std::string s = m_buffer.str();
+    if (m_file && m_saved_fd >= 0) {
+        std::fflush(stderr);
+        std::rewind(m_file);
+        char buf[512];
+        size_t n = 0;
+        while (s.size() < 4096 && (n = std::fread(buf, 1, sizeof buf, m_file)) > 0)
+            s.append(buf, n);
+        std::fseek(m_file, 0, SEEK_END);
+    }
     return s.empty() ? std::string() : one_line(s, 200);
 }
 

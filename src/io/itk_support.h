@@ -2,6 +2,7 @@
 #pragma once
 #include <itkCommonEnums.h>
 
+#include <cstdio>
 #include <exception>
 #include <mutex>
 #include <sstream>
@@ -24,8 +25,9 @@ std::string itk_message(const std::exception& e);
 DiskType disk_type_from_itk(itk::IOComponentEnum c, const std::string& where);
 itk::IOComponentEnum itk_component_of(VoxelType t);
 
-// While alive, std::cerr goes to a buffer instead of the terminal: MetaIO and GDCM print
-// diagnostics there on their own. Holds a process-wide lock, so concurrent ITK calls serialise
+// While alive, std::cerr goes to a buffer and file descriptor 2 to a temporary file instead of
+// the terminal: MetaIO and GDCM print diagnostics to std::cerr on their own, niftilib to C's
+// stderr. Holds a process-wide lock, so concurrent ITK calls serialise
 // (they are I/O bound anyway); another thread printing to std::cerr meanwhile is swallowed.
 // Never call user code (progress callbacks) while one is alive. text() returns what was
 // printed, on one line.
@@ -41,6 +43,8 @@ class QuietStderr {
     std::unique_lock<std::mutex> m_lock;
     std::ostringstream m_buffer;
     std::streambuf* m_saved = nullptr;
+    std::FILE* m_file = nullptr;  // what C code wrote to file descriptor 2 meanwhile
+    int m_saved_fd = -1;
 };
 
 }  // namespace lacuna::io
