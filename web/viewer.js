@@ -149,7 +149,8 @@
 
   function showStats(h) {
     $('o-frame').textContent =
-      `${h.frame_ms.toFixed(1)} ms, ${h.width}×${h.height}${h.preview ? ' (preview)' : ''}, ${fps.toFixed(1)} fps`;
+      `${h.frame_ms.toFixed(1)} ms, ${h.width}×${h.height}${h.preview ? ' (preview)' : ''}` +
+      `${h.reduced > 1 ? ` (render budget: 1/${h.reduced})` : ''}, ${fps.toFixed(1)} fps`;
     $('o-spr').textContent = h.samples_per_ray.toFixed(1);
     $('o-skipped').textContent = (100 * h.skipped).toFixed(1) + ' %';
     if (h.tf_changed) {
