@@ -20,12 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string trim(const std::string& s) {
-    const size_t b = s.find_first_not_of(" \t\r");
-    if (b == std::string::npos) return "";
-    return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
 // True when `p` (canonical) is `dir` (canonical) or lies below it.
 bool is_below(const fs::path& p, const fs::path& dir) {
     const fs::path rel = p.lexically_relative(dir);

@@ -62,6 +62,12 @@ std::string format_bytes(uint64_t bytes) {
 
 namespace lacuna::io {
 
+std::string trim(const std::string& s) {
+    const size_t b = s.find_first_not_of(" \t\r");
+    if (b == std::string::npos) return "";
+    return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
 namespace fs = std::filesystem;
 
 uint64_t grid_bytes(Vec3i d, uint64_t elem) {

@@ -41,6 +41,9 @@ void check_readable_file(const std::string& path);
 // writable (the check is advisory; the real write reports its own failure).
 void check_writable_dir(const std::string& path);
 
+// `s` without leading and trailing blanks (spaces, tabs, carriage returns): header fields.
+std::string trim(const std::string& s);
+
 // Collapses a (possibly multi-line) library message into one trimmed line of at most
 // `max_chars` characters.
 std::string one_line(const std::string& text, size_t max_chars = 300);

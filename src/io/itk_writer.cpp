@@ -22,6 +22,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/io_util.h"
 #include "io/itk_support.h"
 #include "io/readers.h"
 #include "lacuna/error.h"
@@ -34,13 +35,6 @@ itk::ImageIOBase::Pointer make_writer_io(const std::string& ext) {
     if (ext == ".nrrd" || ext == ".nhdr") return itk::NrrdImageIO::New().GetPointer();
     if (ext == ".nii" || ext == ".nii.gz") return itk::NiftiImageIO::New().GetPointer();
     return itk::MetaImageIO::New().GetPointer();
-}
-
-std::string trim(const std::string& s) {
-    const size_t b = s.find_first_not_of(" \t\r");
-    if (b == std::string::npos) return "";
-    const size_t e = s.find_last_not_of(" \t\r");
-    return s.substr(b, e - b + 1);
 }
 
 // Points the temporary detached header at the final data file name, renames the data file,

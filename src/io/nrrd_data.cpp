@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "io/io_util.h"
 #include "lacuna/error.h"
 
 namespace lacuna::io {
@@ -13,12 +14,6 @@ namespace lacuna::io {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string trim(const std::string& s) {
-    const size_t b = s.find_first_not_of(" \t\r");
-    if (b == std::string::npos) return "";
-    return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
 
 // The header's fields that place the data, and where the header ends in its own file.
 struct NrrdFields {

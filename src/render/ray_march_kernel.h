@@ -201,23 +201,10 @@ private:
     LACUNA_ALWAYS_INLINE void lut_entries(int* entry) const {
         const Grid<T, Index>& g = m_g;
         const IndexRay& r = m_r;
-        if constexpr (kNearest) {
-            // nearest()'s operations: position, clamp, the voxel floor(p + 0.5).
-            for (int l = 0; l < kBatch; ++l) {
-                const float t = m_t_base + (float(m_k[l]) + 0.5f) * m_dt;
-                float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
-                x = x < 0.f ? 0.f : (x > g.hi_x ? g.hi_x : x);
-                y = y < 0.f ? 0.f : (y > g.hi_y ? g.hi_y : y);
-                z = z < 0.f ? 0.f : (z > g.hi_z ? g.hi_z : z);
-                const Index off = Index(int(z + 0.5f)) * Index(g.sz) +
-                                  Index(int(y + 0.5f)) * Index(g.sy) + Index(int(x + 0.5f));
-                entry[l] = m_map(float(g.data[off]));
-            }
-            return;
-        }
         float fx[kBatch], fy[kBatch], fz[kBatch];
         Index off[kBatch];
-        // 1. Lattice positions, clamped into the box; cell index and fractions.
+        // 1. Lattice positions, clamped into the box; cell index and fractions (nearest: the
+        // voxel floor(p + 0.5) and its LUT entry, nearest()'s operations, and nothing more).
         {
             for (int l = 0; l < kBatch; ++l) {
                 const float t = m_t_base + (float(m_k[l]) + 0.5f) * m_dt;
@@ -225,6 +212,12 @@ private:
                 x = x < 0.f ? 0.f : (x > g.hi_x ? g.hi_x : x);
                 y = y < 0.f ? 0.f : (y > g.hi_y ? g.hi_y : y);
                 z = z < 0.f ? 0.f : (z > g.hi_z ? g.hi_z : z);
+                if constexpr (kNearest) {
+                    const Index o = Index(int(z + 0.5f)) * Index(g.sz) +
+                                    Index(int(y + 0.5f)) * Index(g.sy) + Index(int(x + 0.5f));
+                    entry[l] = m_map(float(g.data[o]));
+                    continue;
+                }
                 int i = int(x), j = int(y), k = int(z);
                 i = i < g.cell_x ? i : g.cell_x;
                 j = j < g.cell_y ? j : g.cell_y;
@@ -235,6 +228,7 @@ private:
                 off[l] = Index(k) * Index(g.sz) + Index(j) * Index(g.sy) + Index(i);
             }
         }
+        if constexpr (kNearest) return;
         // 2. The 8 corners of each sample's cell.
         float c000[kBatch], c100[kBatch], c010[kBatch], c110[kBatch], c001[kBatch], c101[kBatch],
             c011[kBatch], c111[kBatch];
