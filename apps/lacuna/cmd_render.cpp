@@ -1,6 +1,7 @@
 // `lacuna render`: one frame of a volume to a PNG, with timing and sample statistics; or, with
 // --tf-animate, a sequence while the TF moves between two TFs (bitfield paper, Section 4.5),
 // reporting per structure the time from a TF change to ready-to-render.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +32,8 @@ struct RenderArgs {
     std::string tf;
     std::vector<std::string> tf_animate;
     int frames = 36;
+    int repeat = 1;  // --repeat: the same frame this many times (warm frames, median reported)
+    bool no_refine = false;  // --no-refine: frames without the structure's finer per-TF level
     std::string accel = "auto";  // default_accel() for the ray marcher (docs/cli.md)
     std::string out;
     std::string heatmap;
@@ -115,6 +118,7 @@ Setup validate(RenderArgs& a) {
     if (!std::isfinite(a.azimuth) || !std::isfinite(a.elevation))
         throw Error("--azimuth/--elevation", "angle", "expected finite degrees");
     if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
+    if (a.repeat < 1 || a.repeat > 100000) throw Error("--repeat", "frames", "expected 1..100000");
     s.ro.step = a.step;
     s.ro.interpolation = parse_interpolation(a.interpolation);
     s.ao.interpolation = s.ro.interpolation;
@@ -148,9 +152,9 @@ std::unique_ptr<Accel> build_accel(AccelKind k, const Volume& vol, const AccelOp
 void print_accel(AccelKind k, const Accel& accel) {
     if (k == AccelKind::None) return;
     const AccelStats& st = accel.stats();
-    std::printf("accel %s: build %.1f ms, TF update %.3f ms, %zu nodes, %.2f MiB\n",
-                to_string(k).c_str(), st.build_seconds * 1e3, st.tf_update_seconds * 1e3, st.nodes,
-                double(st.bytes) / (1 << 20));
+    std::printf("accel %s: build %.1f ms, TF update %.3f ms, refine %.3f ms, %zu nodes, %.2f MiB\n",
+                to_string(k).c_str(), st.build_seconds * 1e3, st.tf_update_seconds * 1e3,
+                st.refine_seconds * 1e3, st.nodes, double(st.bytes) / (1 << 20));
 }
 
 void render_one(const RenderArgs& a, const Setup& s) {
@@ -169,9 +173,21 @@ void render_one(const RenderArgs& a, const Setup& s) {
         marcher.set_back_transfer_function(back);
         accel->set_transfer_function(union_lut(lut, back));
     }
+    if (!a.no_refine) accel->refine();  // the structure's finer per-TF level, before the frame
     marcher.set_accel(accel.get());
     const Camera cam = Camera::orbit(marcher.bounds(), s.op, s.w, s.h);
-    const RenderResult r = marcher.render(cam, s.ro);
+    // --repeat N: frame 1 warms caches, pages and threads (as the VTK peer's warm-up render);
+    // the reported time is the median of the N - 1 frames after it (every frame gives the same
+    // bytes: the renderer is deterministic).
+    RenderResult r = marcher.render(cam, s.ro);
+    const double first_ms = r.stats.seconds * 1e3;
+    if (a.repeat > 1) {
+        std::vector<RenderStats> warm;
+        for (int f = 1; f < a.repeat; ++f) warm.push_back(marcher.render(cam, s.ro).stats);
+        std::sort(warm.begin(), warm.end(),
+                  [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
+        r.stats = warm[warm.size() / 2];
+    }
     write_png(a.out, r.image);
     if (!a.heatmap.empty()) write_png(a.heatmap, heatmap(r.sample_counts, s.w, s.h));
     std::printf("%s: %dx%d %s, tf %s, accel %s, %d threads\n", a.volume.path.c_str(), s.w, s.h,
@@ -187,9 +203,12 @@ void render_one(const RenderArgs& a, const Setup& s) {
                     double(r.stats.light_volume_bytes) / (1 << 20), r.stats.light_volume_seconds * 1e3);
     if (r.stats.shadow_samples)
         std::printf("shadow samples: %.1f per ray\n", double(r.stats.shadow_samples) / double(std::max<uint64_t>(r.stats.rays, 1)));
-    std::printf("render time %.1f ms, %.1f samples/ray, %.1f Msamples/s (%.1f per thread)\n",
+    if (a.repeat > 1)
+        std::printf("%d frames: first %.1f ms, the median of the other %d below\n", a.repeat,
+                    first_ms, a.repeat - 1);
+    std::printf("render time %.1f ms, %.1f samples/ray, %.1f Msamples/s (%.1f per thread), CPU %.1f ms\n",
                 r.stats.seconds * 1e3, r.stats.samples_per_ray(), r.stats.msamples_per_second(),
-                r.stats.msamples_per_second() / resolve_threads(a.threads));
+                r.stats.msamples_per_second() / resolve_threads(a.threads), r.stats.cpu_seconds * 1e3);
     std::printf("wrote %s\n", a.out.c_str());
 }
 
@@ -289,6 +308,13 @@ void register_render(CLI::App& app) {
                     "the TF-change time per structure")
         ->expected(2);
     cmd->add_option("--frames", a->frames, "Frames of --tf-animate")->capture_default_str();
+    cmd->add_flag("--no-refine", a->no_refine,
+                  "Render without the structure's finer per-TF level (the grid's visible-cell "
+                  "mask; A/B measurements)");
+    cmd->add_option("--repeat", a->repeat,
+                    "Render the frame N times in this process; report the median of frames 2..N "
+                    "(frame 1 is a warm-up)")
+        ->capture_default_str();
     std::string accels;
     for (const auto& n : accel_names()) accels += (accels.empty() ? "" : ", ") + n;
     cmd->add_option("--accel", a->accel,

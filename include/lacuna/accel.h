@@ -79,6 +79,7 @@ struct AccelOptions {
 struct AccelStats {
     double build_seconds = 0;      // TF-independent build (on load)
     double tf_update_seconds = 0;  // last TF change to ready-to-render
+    double refine_seconds = 0;     // last refine(): the optional finer per-TF level
     size_t bytes = 0;              // memory of the structure
     size_t nodes = 0;              // nodes (octrees) or map voxels (distance maps)
 };
@@ -89,8 +90,15 @@ class Accel {
 public:
     virtual ~Accel() = default;
     AccelKind kind() const { return m_kind; }
-    // Must be called before rendering and whenever the TF changes.
+    // Must be called before rendering and whenever the TF changes; frames are correct (and
+    // exact) right after it.
     virtual void set_transfer_function(const TransferLut& lut) = 0;
+    // Computes the structure's optional finer per-TF level for the current TF (the grid's
+    // visible-cell mask, src/accel/brick_grid.h), which frames use from then on until the next
+    // TF change. It costs more than a TF change, so a front end calls it after the edit, off the
+    // frame's critical path (the CLI before its frame, the viewer after sending one). Never
+    // concurrently with a render. A no-op for structures without one.
+    virtual void refine() {}
     const AccelStats& stats() const { return m_stats; }
     // The sampling this structure is exact for: Trilinear (then also Nearest) or Nearest only.
     Interpolation interpolation() const { return m_interpolation; }

@@ -145,6 +145,7 @@ struct RenderOptions {
 
 struct RenderStats {
     double seconds = 0;
+    double cpu_seconds = 0;  // CPU time of the whole process (all threads) during the frame
     uint64_t samples = 0;   // samples taken
     uint64_t rays = 0;      // rays that hit the volume's box
     uint64_t pixels = 0;

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <type_traits>
 
+#include "accel/cell_ranges.h"
 #include "core/parallel.h"
 
 namespace lacuna {
@@ -159,17 +160,42 @@ void BrickGrid::brick_range(int x, int y, int z, int& lo, int& hi) const {
     hi = m_hi[i];
 }
 
+void BrickGrid::refine() {
+    // Built for Nearest, a brick's occupancy also tests voxel bins, so an unoccupied brick may
+    // hold cells whose range is visible: the mask (a trilinear notion) would be wrong there, and
+    // nearest frames do not read it.
+    if (m_interpolation == Interpolation::Nearest || m_mask_ready) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    // A brick is 0 (empty), 2 when every entry of its apron range is visible (so is every
+    // cell's range, which it contains), else 1.
+    visible_cell_mask(m_volume, m_map, m_next_visible.data(), 1 << m_log2,
+                      [&](int x, int y, int z) {
+                          if (!occupied(x, y, z)) return 0;
+                          const size_t i = slot(x, y, z);
+                          return m_next_invisible[m_lo[i]] > m_hi[i] ? 2 : 1;
+                      },
+                      m_opts.threads, m_mask);
+    m_mask_ready = true;
+    m_stats.refine_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 void BrickGrid::set_transfer_function(const TransferLut& lut) {
     const auto t0 = std::chrono::steady_clock::now();
+    m_mask_ready = false;
     if (needs_rebuild(lut)) build();
     // The prefix count as one lookup: a range [lo, hi] holds a visible entry iff the first
     // visible entry at or after lo is <= hi. (Empty bricks past the grid: lo = 1 > hi = 0.)
     const int size = lut.size();
     m_next_visible.resize(size_t(size) + 1);
     m_next_visible[size_t(size)] = uint16_t(0xffff);
-    for (int e = size - 1; e >= 0; --e)
-        m_next_visible[size_t(e)] =
-            lut.entries[size_t(e)].a > 0.f ? uint16_t(e) : m_next_visible[size_t(e) + 1];
+    m_next_invisible.resize(size_t(size) + 1);
+    m_next_invisible[size_t(size)] = uint16_t(0xffff);
+    for (int e = size - 1; e >= 0; --e) {
+        const bool vis = lut.entries[size_t(e)].a > 0.f;
+        m_next_visible[size_t(e)] = vis ? uint16_t(e) : m_next_visible[size_t(e) + 1];
+        m_next_invisible[size_t(e)] = vis ? m_next_invisible[size_t(e) + 1] : uint16_t(e);
+    }
     m_tf_bins = 0;
     for (int e = 0; e < size; ++e)
         if (lut.entries[size_t(e)].a > 0.f) m_tf_bins |= uint64_t(1) << (int64_t(e) * 64 / size);

@@ -49,6 +49,12 @@ class BrickGrid final : public OctreeBase {
 public:
     BrickGrid(const Volume& v, const AccelOptions& o);
     void set_transfer_function(const TransferLut& lut) override;
+    // The fine level: the visible-cell mask of the current TF (visible_cell_mask in
+    // accel/cell_ranges.h), over the cells of occupied bricks.
+    void refine() override;
+    // The mask once refine() has run for the current TF, else nullptr (the kernels then take
+    // every sample of a run).
+    const uint32_t* cell_mask() const { return m_mask_ready ? m_mask.data() : nullptr; }
 
     int brick_log2() const { return m_log2; }
     const int* bricks() const { return m_nb; }
@@ -106,11 +112,14 @@ private:
     std::vector<uint16_t> m_block_lo, m_block_hi;  // per block: union of its bricks' ranges
     std::vector<uint8_t> m_dist;  // per block: Chebyshev distance to an occupied block, 1..255
     std::vector<uint16_t> m_next_visible;  // per LUT entry: the first visible entry >= it
+    std::vector<uint16_t> m_next_invisible;  // per LUT entry: the first invisible entry >= it
     // Built for Interpolation::Nearest: per brick (slot order) the set of 64 LUT-entry bins of its
     // apron voxels, and the bins of the TF's visible entries (see build_nearest_bins).
     std::vector<uint64_t> m_bins;
     uint64_t m_tf_bins = 0;
     void build_nearest_bins();
+    std::vector<uint32_t> m_mask;
+    bool m_mask_ready = false;
 };
 
 // Front-to-back walk of one ray through the grid; hands out the stretches that may hold visible

@@ -1,6 +1,8 @@
 #include "accel/cell_ranges.h"
 
 #include <algorithm>
+#include <atomic>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -357,6 +359,96 @@ void apron_typed(const Volume& v, const T* data, ValueToLut map, int edge, int t
     });
 }
 
+// visible_cell_mask: per cell row, per occupied brick on it, the column min/max of the row's
+// four voxel rows, then per cell the min/max of two columns and one test. Integer voxels test
+// raw values against a per-TF threshold table: thr[a] is the smallest raw value b whose upper
+// LUT bound reaches the first visible entry at or after a's lower bound, so a cell with corner
+// range [a, b] is visible iff b >= thr[a] (both bounds and next_visible are monotone, so the
+// table is one merge pass). Float voxels map the two extremes. In parallel over cell layers;
+// bits go in with atomic ORs (rows of neighbouring layers can share a word).
+template <class T>
+void mask_typed(const Volume& v, const T* data, ValueToLut map, const uint16_t* next, int edge,
+                const std::function<int(int, int, int)>& brick_state, int threads,
+                std::vector<uint32_t>& mask) {
+    const Vec3i d = v.dims();
+    int cells[3];
+    cell_counts(v, cells);
+    const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
+    mask.assign(v.voxel_count() / 32 + 2, 0u);
+    const VoxelLut<T> vl(map, v.vis_range(), v.data_range());
+    constexpr bool kRaw = VoxelLut<T>::kTable;
+    constexpr int kMin = kRaw ? int(std::numeric_limits<T>::min()) : 0;
+    constexpr int kMax = kRaw ? int(std::numeric_limits<T>::max()) : 0;
+    std::vector<int> thr;
+    if constexpr (kRaw) {
+        thr.resize(size_t(kMax - kMin + 1));
+        int u = kMin;
+        for (int a = kMin; a <= kMax; ++a) {
+            const int need = next[vl.lower(T(a))];
+            while (u <= kMax && int(vl.upper(T(u))) < need) ++u;
+            thr[size_t(a - kMin)] = u;  // kMax + 1: never visible
+        }
+    }
+    const int nbx = (cells[0] + edge - 1) / edge;
+    parallel_for(size_t(cells[2]), threads, [&](size_t k0, size_t k1) {
+        std::vector<T> cmin(static_cast<size_t>(d.x)), cmax(static_cast<size_t>(d.x));
+        std::vector<uint8_t> vis(static_cast<size_t>(cells[0]));
+        std::vector<uint8_t> occ(static_cast<size_t>(nbx));
+        bool any = false;
+        for (int k = int(k0); k < int(k1); ++k)
+            for (int j = 0, by = -1; j < cells[1]; ++j) {
+                if (j / edge != by) {  // the bricks of this row, once per brick row
+                    by = j / edge;
+                    any = false;
+                    for (int bx = 0; bx < nbx; ++bx)
+                        any |= (occ[size_t(bx)] = uint8_t(brick_state(bx, by, k / edge))) != 0;
+                }
+                if (!any) continue;
+                const size_t base = size_t(k) * sz + size_t(j) * sy;
+                const T* r00 = data + base;
+                const T* r10 = r00 + sy;
+                const T* r01 = r00 + sz;
+                const T* r11 = r01 + sy;
+                std::fill(vis.begin(), vis.end(), uint8_t(0));
+                for (int bx = 0; bx < nbx; ++bx) {
+                    if (!occ[size_t(bx)]) continue;
+                    const int i0 = bx * edge, i1 = std::min(cells[0], i0 + edge);
+                    if (occ[size_t(bx)] == 2) {  // every cell visible
+                        std::fill(vis.begin() + i0, vis.begin() + i1, uint8_t(1));
+                        continue;
+                    }
+                    for (int x = i0; x <= i1; ++x) {
+                        cmin[size_t(x)] = std::min(std::min(r00[x], r10[x]), std::min(r01[x], r11[x]));
+                        cmax[size_t(x)] = std::max(std::max(r00[x], r10[x]), std::max(r01[x], r11[x]));
+                    }
+                    for (int i = i0; i < i1; ++i) {
+                        const T a = std::min(cmin[size_t(i)], cmin[size_t(i) + 1]);
+                        const T b = std::max(cmax[size_t(i)], cmax[size_t(i) + 1]);
+                        if constexpr (kRaw) {
+                            vis[size_t(i)] = int(b) >= thr[size_t(int(a) - kMin)];
+                        } else {
+                            uint16_t lo, hi, l2, h2;
+                            vl.compute(float(a), lo, h2);
+                            vl.compute(float(b), l2, hi);
+                            vis[size_t(i)] = next[lo] <= hi;
+                        }
+                    }
+                }
+                // The row's bits into its mask words (offsets base .. base + cells - 1).
+                for (int i = 0; i < cells[0];) {
+                    const size_t o = base + size_t(i), w = o >> 5;
+                    const int n = std::min(cells[0] - i, 32 - int(o & 31));
+                    uint32_t bits = 0;
+                    for (int q = 0; q < n; ++q) bits |= uint32_t(vis[size_t(i + q)]) << q;
+                    if (bits)
+                        std::atomic_ref<uint32_t>(mask[w]).fetch_or(bits << (o & 31),
+                                                                    std::memory_order_relaxed);
+                    i += n;
+                }
+            }
+    });
+}
+
 }  // namespace
 
 void apron_brick_ranges(const Volume& v, ValueToLut map, int edge, int threads,
@@ -378,6 +470,14 @@ void for_each_cell_chunk_row(const Volume& v, ValueToLut map, int chunk, int thr
 void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,
                           const std::function<void(const BlockCells&)>& fn) {
     visit_voxels(v, [&](const auto* data) { blocks_typed(v, data, map, edge, threads, fn); });
+}
+
+void visible_cell_mask(const Volume& v, ValueToLut map, const uint16_t* next_visible, int edge,
+                       const std::function<int(int, int, int)>& brick_state, int threads,
+                       std::vector<uint32_t>& mask) {
+    visit_voxels(v, [&](const auto* data) {
+        mask_typed(v, data, map, next_visible, edge, brick_state, threads, mask);
+    });
 }
 
 }  // namespace lacuna

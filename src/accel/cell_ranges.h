@@ -72,6 +72,17 @@ void for_each_cell_chunk_row(const Volume& v, ValueToLut map, int chunk, int thr
 void apron_brick_ranges(const Volume& v, ValueToLut map, int edge, int threads,
                         std::vector<uint16_t>& lo, std::vector<uint16_t>& hi);
 
+// The visible-cell mask of one TF: bit o of `mask` (32-bit words, bit o & 31 of word o >> 5) is
+// set iff the cell whose first corner is voxel offset o = i + j*dx + k*dx*dy may read a visible
+// LUT entry: its corner range, widened as every range here is, holds an entry e with
+// next_visible[e] <= hi (next_visible[e]: the first visible entry at or after e). Per brick of
+// `edge` cells, brick_state(bx, by, bz) says 0: no cell visible (bits stay clear), 2: every cell
+// visible (bits set without looking), 1: test each cell. Offsets that are no cell's
+// (i = dx - 1, ...) stay clear. mask gets voxels / 32 + 2 words.
+void visible_cell_mask(const Volume& v, ValueToLut map, const uint16_t* next_visible, int edge,
+                       const std::function<int(int, int, int)>& brick_state, int threads,
+                       std::vector<uint32_t>& mask);
+
 // Cells per axis (dims - 1) and blocks per axis for a block edge.
 inline void cell_counts(const Volume& v, int cells[3]) {
     const Vec3i d = v.dims();

@@ -32,6 +32,10 @@ struct ShadeGrid {
     float inv_sp[3];   // 1 / spacing: index-space differences -> values per mm
     float lut_offset, lut_scale, lut_last;  // ValueToLut
     const float* alpha;  // TF opacities, every 4th float (&Rgba::a of the front LUT)
+    // The structure's visible-cell mask (accel/cell_ranges.h visible_cell_mask), or nullptr.
+    // A batch none of whose cells is visible is exactly transparent: samples4/8 return an
+    // empty mask without interpolating (x, y, z are still written; v and e are not).
+    const uint32_t* cell_mask = nullptr;
 };
 
 // One ray's sample lattice in index space: sample k at o + t*d, t = t_base + (k + 0.5)*dt
@@ -92,6 +96,22 @@ inline int samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const 
     const __m128 py = _mm_add_ps(_mm_set1_ps(r.o[1]), _mm_mul_ps(t, _mm_set1_ps(r.d[1])));
     const __m128 pz = _mm_add_ps(_mm_set1_ps(r.o[2]), _mm_mul_ps(t, _mm_set1_ps(r.d[2])));
     _mm_storeu_ps(x, px), _mm_storeu_ps(y, py), _mm_storeu_ps(z, pz);
+    if (g.cell_mask) {
+        // The cells trilinear4 reads (its clamp and truncation), tested in the mask.
+        __m128i c[3];
+        const __m128 p[3] = {px, py, pz};
+        for (int a = 0; a < 3; ++a)
+            c[a] = _mm_min_epi32(_mm_cvttps_epi32(_mm_max_ps(zero, _mm_min_ps(_mm_set1_ps(g.hi[a]), p[a]))),
+                                 _mm_set1_epi32(g.cell[a]));
+        alignas(16) uint32_t o[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(o),
+                        _mm_add_epi32(_mm_add_epi32(_mm_mullo_epi32(c[2], _mm_set1_epi32(g.sz)),
+                                                    _mm_mullo_epi32(c[1], _mm_set1_epi32(g.sy))),
+                                      c[0]));
+        uint32_t any = 0;
+        for (int l = 0; l < 4; ++l) any |= g.cell_mask[o[l] >> 5] >> (o[l] & 31);
+        if (!(any & 1u)) return 0;
+    }
     const __m128 val = trilinear4(g, data, px, py, pz);
     _mm_storeu_ps(v, val);
     __m128 u = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(val, _mm_set1_ps(g.lut_offset)), _mm_set1_ps(g.lut_scale)), half);
@@ -152,6 +172,27 @@ LACUNA_AVX2 int samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, c
     const __m256 py = _mm256_add_ps(_mm256_set1_ps(r.o[1]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[1])));
     const __m256 pz = _mm256_add_ps(_mm256_set1_ps(r.o[2]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[2])));
     _mm256_storeu_ps(x, px), _mm256_storeu_ps(y, py), _mm256_storeu_ps(z, pz);
+    if (g.cell_mask) {
+        // The cells trilinear8 reads (its clamp and truncation), one gather from the mask.
+        const __m256i ci = _mm256_min_epi32(
+            _mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), px))),
+            _mm256_set1_epi32(g.cell[0]));
+        const __m256i cj = _mm256_min_epi32(
+            _mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), py))),
+            _mm256_set1_epi32(g.cell[1]));
+        const __m256i ck = _mm256_min_epi32(
+            _mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), pz))),
+            _mm256_set1_epi32(g.cell[2]));
+        const __m256i off = _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                             _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+            ci);
+        const __m256i w = _mm256_i32gather_epi32(reinterpret_cast<const int*>(g.cell_mask),
+                                                 _mm256_srli_epi32(off, 5), 4);
+        const __m256i bit = _mm256_and_si256(
+            _mm256_srlv_epi32(w, _mm256_and_si256(off, _mm256_set1_epi32(31))), _mm256_set1_epi32(1));
+        if (_mm256_testz_si256(bit, bit)) return 0;
+    }
     const __m256 val = trilinear8(g, data, px, py, pz);
     _mm256_storeu_ps(v, val);
     __m256 u = _mm256_add_ps(

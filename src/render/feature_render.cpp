@@ -177,6 +177,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
     std::atomic<uint64_t> samples{0}, rays{0}, shadow{0};
     const Vec3i d = m_volume.dims();
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = process_cpu_seconds();
     visit_voxels(m_volume, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
         // The feature path always indexes with int64 (it is not the hot path for huge grids).
@@ -211,7 +212,11 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             // active ISA (int32 offsets: grids under 2^31 voxels), the rest one sample at a
             // time (feature::composite_ray, the reference; also the scalar ISA path).
             const int dims[3] = {d.x, d.y, d.z};
-            const simd::ShadeGrid sg = feature::shade_grid(c, dims);
+            simd::ShadeGrid sg = feature::shade_grid(c, dims);
+            // The structure's visible-cell mask (refined grids), for the plain batched case: one
+            // TF (the structure's), no clip planes or crop box, trilinear samples.
+            if constexpr (requires { acc.cell_mask(); })
+                if (!c.nearest && !c.two_tfs && c.n_clips == 0 && !f.crop) sg.cell_mask = acc.cell_mask();
             // Nearest sampling runs the reference too (one path for every ISA, so still exact).
             const bool batched = composite && !f.shadows.enabled && !f.gradient_opacity.enabled &&
                                  !c.nearest &&
@@ -240,6 +245,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
         });
     });
     out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out.stats.cpu_seconds = process_cpu_seconds() - cpu0;
     out.stats.samples = samples;
     out.stats.rays = rays;
     out.stats.shadow_samples = shadow;

@@ -317,6 +317,7 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
     std::atomic<uint64_t> samples{0}, rays{0};
     const simd::Isa isa = simd::active_isa();
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = process_cpu_seconds();
     visit_voxels(m_volume, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
         const bool small = m_volume.voxel_count() < (size_t(1) << 31);
@@ -338,6 +339,7 @@ RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) con
     });
     const auto t1 = std::chrono::steady_clock::now();
     out.stats.seconds = std::chrono::duration<double>(t1 - t0).count();
+    out.stats.cpu_seconds = process_cpu_seconds() - cpu0;
     out.stats.samples = samples;
     out.stats.rays = rays;
     out.stats.pixels = uint64_t(cam.width()) * cam.height();

@@ -200,6 +200,11 @@ Frame FrameRenderer::render_segments(const ViewRequest& req, int width, int heig
     return f;
 }
 
+void FrameRenderer::refine() {
+    for (auto& [kind, b] : m_accels)
+        if (b.accel) b.accel->refine();
+}
+
 Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     if (req.renderer == RendererKind::Slice) return render_slice(req, width, height);
     if (req.segments && m_labels) return render_segments(req, width, height);

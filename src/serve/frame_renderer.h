@@ -52,6 +52,10 @@ class FrameRenderer {
 
     // Renders `req` at width x height (the server passes a reduced size for previews).
     Frame render(const ViewRequest& req, int width, int height);
+    // Computes the built structures' finer per-TF level (Accel::refine) for the current TF:
+    // the server calls it when the render thread is idle, after a frame went out, so a TF edit
+    // never waits for it and the frames after it use it.
+    void refine();
 
     // The camera a request describes, for an image of width x height.
     Camera camera(const ViewCamera& c, int width, int height) const;

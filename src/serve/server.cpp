@@ -492,6 +492,13 @@ void Server::Impl::render_loop() {
             info.encode_ms = ms_between(e0, Clock::now());
             message = frame_message(info, jpeg);
             net::post(ioc, [s, m = std::move(message)]() mutable { s->send_frame(std::move(m)); });
+            // Idle after a full frame: the structure's finer per-TF level, for the next frames.
+            bool idle;
+            {
+                std::lock_guard<std::mutex> lock(slot_mutex);
+                idle = ready.empty();
+            }
+            if (idle && !req.preview) renderer.refine();
         } catch (const std::exception& e) {
             // lacuna::Error (e.g. a structure's options) or out of memory: report, keep serving.
             net::post(ioc,

@@ -91,6 +91,51 @@ TEST(BrickGrid, BitsAreThePrefixCountOfTheRangesAndBricksPastTheGridAreEmpty) {
     }
 }
 
+// refine(): the visible-cell mask holds, for every cell, whether its built (widened) range
+// holds a visible entry (brute-force scan of the LUT), at the offset of its first corner voxel;
+// every other offset is clear; a TF change drops the mask until the next refine().
+TEST(BrickGrid, RefinedCellMaskIsTheVisibilityOfEveryCellsRange) {
+    Rng rng{9107};
+    int visible = 0, invisible = 0;
+    for (int trial = 0; trial < 32; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 36), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 3);
+        o.threads = rng.range(1, 3);
+        BrickGrid g(v, o);
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        TransferLut lut = random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng));
+        if (trial % 8 == 7)  // everything visible but one entry band: fully visible bricks
+            for (size_t e = 0; e < lut.entries.size(); ++e) lut.entries[e].a = e % 97 < 90 ? 0.5f : 0.f;
+        g.set_transfer_function(lut);
+        ASSERT_EQ(g.cell_mask(), nullptr) << "no mask before refine()";
+        g.refine();
+        const uint32_t* mask = g.cell_mask();
+        ASSERT_NE(mask, nullptr);
+        const BuiltRanges cells = built_ranges(v, m, -4);
+        const Vec3i d = v.dims();
+        std::vector<uint8_t> is_cell(v.voxel_count(), 0);
+        for (int k = 0; k < cells.g.n[2]; ++k)
+            for (int j = 0; j < cells.g.n[1]; ++j)
+                for (int i = 0; i < cells.g.n[0]; ++i) {
+                    const size_t off = (size_t(k) * d.y + j) * d.x + i;
+                    is_cell[off] = 1;
+                    const size_t id = cells.g.index(i, j, k);
+                    const bool expect = scan_visible(lut, cells.lo[id], cells.hi[id]);
+                    const bool got = (mask[off >> 5] >> (off & 31)) & 1u;
+                    ASSERT_EQ(got, expect) << describe(v, lut) << " cell " << i << "," << j << ","
+                                           << k << " leaf " << o.leaf_cells;
+                    (expect ? visible : invisible)++;
+                }
+        for (size_t off = 0; off < v.voxel_count(); ++off)
+            if (!is_cell[off]) ASSERT_FALSE((mask[off >> 5] >> (off & 31)) & 1u) << "offset " << off;
+        g.set_transfer_function(empty_lut(v.vis_range()));
+        ASSERT_EQ(g.cell_mask(), nullptr) << "a TF change drops the mask";
+    }
+    EXPECT_GT(visible, 1000);
+    EXPECT_GT(invisible, 1000);
+}
+
 // Zero everywhere but a few random voxels: empty blocks to leap over.
 Volume sparse_volume(VoxelType t, Vec3i dims, Rng& rng) {
     Volume v(dims, t);
