@@ -21,6 +21,7 @@
 #include <type_traits>
 
 #include "core/simd_lanes.h"
+#include "core/spec_pow.h"
 
 namespace lacuna::simd {
 
@@ -237,8 +238,9 @@ LACUNA_AVX2 inline void volume_gradients8(const ShadeGrid& g, const float* const
 // direction l, intensity li and half vector h are the same for all lanes (head and directional
 // lights, once per ray), with the view direction v. Lane by lane the operations of the scalar
 // functions in their order (std::max(a, c) == max_ps(c, a); sqrt and div are correctly
-// rounded); the specular power stays std::pow, called per lane (no vector pow is bit-exact).
-// A lane whose gradient is zero keeps its colour. Lanes n..7 are computed but not pow'ed.
+// rounded); the specular power is shading::spec_pow's: an integer power by its multiplies in
+// lanes (spec_pow8), any other by std::pow per lane (no vector pow is bit-exact). A lane whose
+// gradient is zero keeps its colour. Lanes n..7 are computed but not pow'ed.
 struct ShadeLight {
     float l[3], v[3], h[3];  // unit vectors: to the light, to the eye, half vector
     bool h_ok;               // |l + v| > 0 (phong: no specular otherwise; pbr: h = n per lane)
@@ -276,6 +278,17 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 normals8(const float* g
     return ok;
 }
 
+// shading::spec_pow for an integer power, eight lanes: the same multiplies in the same order.
+LACUNA_AVX2 inline __m256 spec_pow8(__m256 x, int power) {
+    __m256 r = _mm256_set1_ps(1.f), b = x;
+    for (int n = power;;) {
+        if (n & 1) r = _mm256_mul_ps(r, b);
+        n >>= 1;
+        if (!n) return r;
+        b = _mm256_mul_ps(b, b);
+    }
+}
+
 // r, g, b in place: the shaded colours of lanes < n.
 LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const float* gx,
                                const float* gy, const float* gz, float* r, float* g, float* b,
@@ -286,11 +299,17 @@ LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const f
     const __m256 ndl = _mm256_max_ps(zero, dot8(nx, ny, nz, L.l));
     alignas(32) float spec[8] = {};
     if (L.h_ok) {
-        alignas(32) float ndh[8], lit[8];
-        _mm256_store_ps(ndh, _mm256_max_ps(zero, dot8(nx, ny, nz, L.h)));
-        _mm256_store_ps(lit, _mm256_and_ps(ok, _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ)));
-        for (int j = 0; j < n; ++j)
-            if (lit[j] != 0.f) spec[j] = std::pow(ndh[j], p.power);
+        const __m256 vndh = _mm256_max_ps(zero, dot8(nx, ny, nz, L.h));
+        const __m256 vlit = _mm256_and_ps(ok, _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ));
+        if (integer_power(p.power)) {
+            _mm256_store_ps(spec, _mm256_and_ps(vlit, spec_pow8(vndh, int(p.power))));
+        } else {
+            alignas(32) float ndh[8], lit[8];
+            _mm256_store_ps(ndh, vndh);
+            _mm256_store_ps(lit, vlit);
+            for (int j = 0; j < n; ++j)
+                if (lit[j] != 0.f) spec[j] = std::pow(ndh[j], p.power);
+        }
     }
     const __m256 vli = _mm256_set1_ps(L.li);
     const __m256 k = _mm256_add_ps(_mm256_set1_ps(p.ambient),

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/spec_pow.h"
 #include "lacuna/math.h"
 #include "lacuna/renderer.h"
 
@@ -35,7 +36,7 @@ inline Vec3f phong_h(const PhongParams& p, Vec3f rgb, Vec3f n, Vec3f l, Vec3f hn
                      float li) {
     const float ndl = std::max(dot(n, l), 0.f);
     float spec = 0.f;
-    if (ndl > 0.f && h_ok) spec = std::pow(std::max(dot(n, hn), 0.f), p.power);
+    if (ndl > 0.f && h_ok) spec = simd::spec_pow(std::max(dot(n, hn), 0.f), p.power);
     const float k = p.ambient + p.diffuse * li * ndl;
     const float s = p.specular * li * spec;
     return {rgb.x * k + s, rgb.y * k + s, rgb.z * k + s};
