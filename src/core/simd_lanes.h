@@ -81,6 +81,7 @@ struct CameraView {
 };
 struct RayBatch8 {
     alignas(32) float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8], t_near[8], t_far[8];
+    alignas(32) float wx[8], wy[8], wz[8];  // the world direction (Camera::generate's Ray::dir)
     alignas(32) int32_t hit[8];  // -1: the ray meets the box [0, hi]
 };
 
@@ -751,6 +752,7 @@ LACUNA_AVX2 inline void setup_rays8(const CameraView& c, const float* px, const 
             _mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])), _mm256_mul_ps(d[2], d[2])));
         for (int a = 0; a < 3; ++a) d[a] = _mm256_div_ps(d[a], len);
     }
+    _mm256_store_ps(out.wx, d[0]), _mm256_store_ps(out.wy, d[1]), _mm256_store_ps(out.wz, d[2]);
     __m256 t0 = _mm256_setzero_ps(), t1 = _mm256_set1_ps(__builtin_inff());
     __m256 miss = _mm256_setzero_ps();
     for (int a = 0; a < 3; ++a) {

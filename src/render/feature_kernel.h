@@ -664,15 +664,41 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
     const FeatureOptions& f = *c.f;
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     const float chunk = kCursorChunk * c.dt;
+    // The eight-lane paths set rays up eight pixels at a time (simd::setup_rays8: the operations
+    // of Camera::generate, index_ray and intersect_box, lane by lane).
+    constexpr bool kBatchSetup = [] {
+        if constexpr (std::is_void_v<Ops>) return false;
+        else return Ops::kShades;
+    }();
+    [[maybe_unused]] const simd::CameraView cv = camera_view(cam);
+    [[maybe_unused]] const float isp[3] = {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z};
+    [[maybe_unused]] simd::RayBatch8 rb;
     for (int py = y0; py < y1; ++py) {
         for (int px = x0; px < x1; ++px) {
-            const Ray wr = cam.generate(float(px), float(py));
-            const kernel::IndexRay r = index_ray(wr, c.inv_sp);
-            const Vec3f view = -wr.dir;
+            kernel::IndexRay r;
+            Vec3f view;
+            float t_near, t_far;
+            bool hit;
+            if constexpr (kBatchSetup) {
+                const int i = (px - x0) & 7;
+                if (i == 0) {
+                    alignas(32) float bx[8], by[8];
+                    for (int q = 0; q < 8; ++q) bx[q] = float(std::min(px + q, x1 - 1)), by[q] = float(py);
+                    simd::setup_rays8(cv, bx, by, isp, hi, rb);
+                }
+                r = {rb.ox[i], rb.oy[i], rb.oz[i], rb.dx[i], rb.dy[i], rb.dz[i]};
+                view = -Vec3f{rb.wx[i], rb.wy[i], rb.wz[i]};
+                t_near = rb.t_near[i], t_far = rb.t_far[i];
+                hit = rb.hit[i] != 0;
+            } else {
+                const Ray wr = cam.generate(float(px), float(py));
+                r = index_ray(wr, c.inv_sp);
+                view = -wr.dir;
+                hit = kernel::intersect_box(r, hi, t_near, t_far);
+            }
             kernel::Accum acc;
             uint32_t n = 0;
-            float t_near, t_far;
-            if (kernel::intersect_box(r, hi, t_near, t_far)) {
+            if (hit) {
                 ++counts.rays;
                 const float j = f.jitter ? jitter(uint32_t(px), uint32_t(py), f.jitter_seed) : 0.5f;
                 const float t_base = t_near + (j - 0.5f) * c.dt;
