@@ -47,6 +47,31 @@ TEST(Cli, RendersAGeneratedVolumeAndReportsTiming) {
     EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
 }
 
+// --repeat N renders the frame N times and reports the median of the warm ones; --no-refine
+// renders without the grid's visible-cell mask. Neither changes a byte of the picture (shaded,
+// where the mask is used). Bad counts: one line, exit 2, no file.
+TEST(Cli, RepeatAndNoRefineKeepThePictureAndReportTimes) {
+    const std::string base = "render " + small_volume().string() +
+                             " --tf mr-default --size 48 --shading phong --accel grid --out ";
+    const fs::path a = temp_dir() / "rep-a.png", b = temp_dir() / "rep-b.png",
+                   c = temp_dir() / "rep-c.png";
+    CliRun r1 = run(base + a.string());
+    ASSERT_EQ(r1.code, 0) << r1.err;
+    EXPECT_NE(r1.out.find(", CPU "), std::string::npos) << r1.out;
+    EXPECT_NE(r1.out.find("refine "), std::string::npos) << r1.out;
+    CliRun r2 = run(base + b.string() + " --repeat 3");
+    ASSERT_EQ(r2.code, 0) << r2.err;
+    EXPECT_NE(r2.out.find("3 frames: first"), std::string::npos) << r2.out;
+    CliRun r3 = run(base + c.string() + " --no-refine");
+    ASSERT_EQ(r3.code, 0) << r3.err;
+    EXPECT_NE(r3.out.find("refine 0.000 ms"), std::string::npos) << r3.out;
+    EXPECT_EQ(slurp(a), slurp(b));
+    EXPECT_EQ(slurp(a), slurp(c));
+    const fs::path bad = temp_dir() / "rep-bad.png";
+    expect_one_line_error(run(base + bad.string() + " --repeat 0"), "--repeat");
+    EXPECT_FALSE(fs::exists(bad));
+}
+
 TEST(Cli, TfAnimationWritesFramesAndReportsTfChangeTime) {
     const fs::path png = temp_dir() / "anim.png";
     CliRun r = run("render " + small_volume().string() +
