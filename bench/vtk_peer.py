@@ -108,7 +108,7 @@ def parse_args(argv):
     p.add_argument("--accel", default="", help="passed to lacuna render when given")
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--step", type=float, default=0.5)
-    p.add_argument("--azimuth", type=float, default=200.0)
+    p.add_argument("--azimuth", type=float, default=20.0)
     p.add_argument("--elevation", type=float, default=15.0)
     p.add_argument("--tree-size", type=int, default=512)
     p.add_argument("--command", default="", help="the command line for the report")
@@ -211,7 +211,8 @@ def vtk_read(path):
 def to_eye(az_deg, el_deg):
     """Camera::orbit's unit direction from the target to the eye."""
     az, el = math.radians(az_deg), math.radians(el_deg)
-    return (math.sin(az) * math.cos(el), -math.cos(az) * math.cos(el), math.sin(el))
+    # Azimuth 0 is the anterior view (the eye on +y), 90 the left view (lacuna/camera.h).
+    return (-math.sin(az) * math.cos(el), math.cos(az) * math.cos(el), math.sin(el))
 
 
 def orbit_camera(bounds_hi, az_deg, el_deg, fov_deg=30.0):

@@ -191,6 +191,7 @@
     } else if (p.pan) {
       panBy(dx, dy);
     } else {
+      $('view-name').value = '';
       cam.azimuth = (cam.azimuth - dx * 0.4) % 360;
       cam.elevation = clamp(cam.elevation + dy * 0.4, -89, 89);
     }
@@ -275,6 +276,18 @@
   });
   $('hide').addEventListener('change', (e) => { state.hide = e.target.value.trim(); request(false); });
   $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; if (state.shading) { marchIfSlicer(); noSegments(); } request(false); });
+  // Named anatomical views (lacuna render --view): azimuth about superior from the anterior
+  // view, elevation toward superior (the orbit stops at +-89 degrees).
+  const kViews = { anterior: [0, 0], posterior: [180, 0], left: [90, 0], right: [270, 0],
+                   superior: [0, 89], inferior: [0, -89] };
+  $('view-name').addEventListener('change', (e) => {
+    const v = kViews[e.target.value];
+    if (!v) return;
+    state.camera.azimuth = v[0];
+    state.camera.elevation = v[1];
+    state.camera.pan = [0, 0];
+    request(false);
+  });
   $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; if (state.clip) { marchIfSlicer(); noSegments(); } request(false); });
   $('step').addEventListener('input', (e) => {
     state.step = Number(e.target.value);

@@ -36,6 +36,13 @@ Vec3i parse_dims(const std::string& s, const std::string& where);
 // writable, and it must end with `ext`. Throws lacuna::Error(path, "output", ...).
 void check_output_path(const std::string& path, const std::string& ext);
 
+// A named anatomical view (Slicer's): anterior, posterior, left, right, superior, inferior, as
+// orbit azimuth and elevation (lacuna/camera.h OrbitParams). Throws lacuna::Error with the list.
+void parse_view(const std::string& name, float& azimuth, float& elevation);
+inline constexpr const char* kViewHelp =
+    "Anatomical view: anterior, posterior, left, right, superior or inferior (sets --azimuth and "
+    "--elevation; world is patient RAS)";
+
 // A progress line on stderr, shown only when stderr is a terminal.
 class Progress {
 public:

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cli_common.h"
+#include "lacuna/orientation.h"
 
 namespace lacuna::cli {
 
@@ -18,10 +19,23 @@ void run(const VolumeArgs& args) {
                 double(v.bytes()) / (1 << 20));
     std::printf("type:        %s\n", to_string(v.type()).c_str());
     std::printf("spacing:     %g x %g x %g mm\n", v.spacing.x, v.spacing.y, v.spacing.z);
-    std::printf("origin:      %g, %g, %g\n", v.origin.x, v.origin.y, v.origin.z);
-    std::printf("orientation: [%g %g %g] [%g %g %g] [%g %g %g]\n", v.direction[0], v.direction[1],
-                v.direction[2], v.direction[3], v.direction[4], v.direction[5], v.direction[6],
-                v.direction[7], v.direction[8]);
+    // World frame (docs/formats.md): patient RAS mm; origin and direction also in ITK's LPS.
+    const Affine a = index_to_world(v);
+    const Box3f wb = world_bounds(v);
+    std::printf("orientation: %s (the RAS direction +i, +j, +k point toward)\n",
+                orientation_code(v).c_str());
+    std::printf("geometry:    %s\n", v.geometry_source.empty()
+                                          ? "none in the file: world = index x spacing"
+                                          : v.geometry_source.c_str());
+    std::printf("affine:      RAS mm = [%g %g %g %g] [%g %g %g %g] [%g %g %g %g] * (i, j, k, 1)\n",
+                a.m[0][0], a.m[0][1], a.m[0][2], a.t[0], a.m[1][0], a.m[1][1], a.m[1][2], a.t[1],
+                a.m[2][0], a.m[2][1], a.m[2][2], a.t[2]);
+    std::printf("RAS bounds:  x %g .. %g, y %g .. %g, z %g .. %g mm\n", wb.lo.x, wb.hi.x, wb.lo.y,
+                wb.hi.y, wb.lo.z, wb.hi.z);
+    std::printf("origin:      %g, %g, %g (LPS)\n", v.origin.x, v.origin.y, v.origin.z);
+    std::printf("direction:   [%g %g %g] [%g %g %g] [%g %g %g] (LPS, row-major)\n", v.direction[0],
+                v.direction[1], v.direction[2], v.direction[3], v.direction[4], v.direction[5],
+                v.direction[6], v.direction[7], v.direction[8]);
     const ValueRange r = v.data_range(), vr = v.vis_range();
     std::printf("value range: %g .. %g\n", r.min, r.max);
     std::printf("vis range:   %g .. %g\n", vr.min, vr.max);

@@ -17,6 +17,7 @@
 
 #include "accel/kdtree_partition.h"
 #include "cli_common.h"
+#include "lacuna/orientation.h"
 #include "partition_boxes.h"
 #include "core/parallel.h"
 #include "io/io_util.h"
@@ -42,6 +43,7 @@ struct PartitionArgs {
     std::string json, out;
     int size = 512;
     float azimuth = 30.f, elevation = 20.f;
+    std::string view;  // --view: a named anatomical view (sets azimuth and elevation)
     int threads = 0;
     int repeat = 1;
     // --method boxes (growing-boxes paper): typed options, the picture's slice, merging.
@@ -249,9 +251,11 @@ void run(const PartitionArgs& a) {
     OrbitParams op;
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
-    const Camera cam = Camera::orbit(marcher.bounds(), op, a.size, a.size);
-    const Vec3f eye_index{float(cam.eye().x / vol.spacing.x), float(cam.eye().y / vol.spacing.y),
-                          float(cam.eye().z / vol.spacing.z)};
+    const Camera cam = Camera::orbit(marcher.bounds(), op, a.size, a.size);  // world (RAS)
+    // The boxes live in the volume frame (index * spacing): project and order them there.
+    const Camera vcam = to_volume_frame(volume_frame(vol), cam);
+    const Vec3f eye_index{float(vcam.eye().x / vol.spacing.x), float(vcam.eye().y / vol.spacing.y),
+                          float(vcam.eye().z / vol.spacing.z)};
     const std::vector<CellBox> boxes = part.boxes_in_visibility_order(eye_index);
 
     const Vec3i d = vol.dims();
@@ -328,7 +332,7 @@ void run(const PartitionArgs& a) {
         RenderOptions ro;
         ro.threads = a.threads;
         RenderResult r = marcher.render(cam, ro);
-        const Projector proj(cam);
+        const Projector proj(vcam);
         const int w = a.size >= 384 ? 2 : 1;
         for (size_t i = 0; i < boxes.size(); ++i)
             draw_box(r.image, proj, boxes[i], vol.spacing, w, kPalette[i % std::size(kPalette)]);
@@ -370,6 +374,7 @@ void register_partition(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--elevation", a->elevation, "Overlay orbit elevation in degrees")
         ->capture_default_str();
+    cmd->add_option("--view", a->view, kViewHelp);
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
         ->capture_default_str();
     cmd->add_option("--repeat", a->repeat,
@@ -395,7 +400,14 @@ void register_partition(CLI::App& app) {
     cmd->add_flag("--no-merge", a->no_merge, "boxes: skip the BSP tree's bottom-up merging");
     cmd->add_option("--slice", a->slice, "boxes: z cell layer of the picture (-1 = middle)")
         ->capture_default_str();
-    cmd->callback([a] { run(*a); });
+    cmd->callback([a, cmd] {
+        if (!a->view.empty()) {
+            if (cmd->count("--azimuth") || cmd->count("--elevation"))
+                throw Error("--view", "view", "sets the azimuth and elevation; drop --azimuth/--elevation");
+            parse_view(a->view, a->azimuth, a->elevation);
+        }
+        run(*a);
+    });
 }
 
 }  // namespace lacuna::cli

@@ -24,7 +24,7 @@ namespace {
 // mricron-data), seen obliquely from the front left.
 constexpr const char* kDemoVolume = "/usr/share/mricron/templates/ch2better.nii.gz";
 constexpr const char* kDemoTf = "mr-brain";
-constexpr float kDemoAzimuth = 210.f, kDemoElevation = 30.f;
+constexpr float kDemoAzimuth = 30.f, kDemoElevation = 30.f;  // the face, from the front-left
 
 struct RenderArgs {
     VolumeArgs volume;
@@ -42,6 +42,7 @@ struct RenderArgs {
     float azimuth = 30.f, elevation = 15.f, zoom = 1.f, fov = 30.f;
     bool ortho = false;
     bool azimuth_given = false, elevation_given = false;
+    std::string view;  // --view: a named anatomical view
     float step = 0.5f, ert = 0.99f;
     std::string interpolation = "trilinear";
     int threads = 0;
@@ -92,6 +93,12 @@ struct Setup {
 };
 
 Setup validate(RenderArgs& a) {
+    if (!a.view.empty()) {
+        if (a.azimuth_given || a.elevation_given)
+            throw Error("--view", "view", "sets the azimuth and elevation; drop --azimuth/--elevation");
+        parse_view(a.view, a.azimuth, a.elevation);
+        a.azimuth_given = a.elevation_given = true;
+    }
     if (a.demo) {
         if (a.volume.path.empty()) a.volume.path = kDemoVolume;
         if (a.tf.empty()) a.tf = kDemoTf;
@@ -333,8 +340,13 @@ void register_render(CLI::App& app) {
     cmd->add_option("--size", a->size, "Image width and height in pixels")->capture_default_str();
     cmd->add_option("--width", a->width, "Image width (overrides --size)");
     cmd->add_option("--height", a->height, "Image height (overrides --size)");
-    cmd->add_option("--azimuth", a->azimuth, "Orbit azimuth in degrees")->capture_default_str();
-    cmd->add_option("--elevation", a->elevation, "Orbit elevation in degrees")->capture_default_str();
+    cmd->add_option("--azimuth", a->azimuth,
+                    "Orbit azimuth in degrees about the patient's superior axis, from the anterior "
+                    "view (90: from the left)")
+        ->capture_default_str();
+    cmd->add_option("--elevation", a->elevation, "Orbit elevation in degrees (toward superior)")
+        ->capture_default_str();
+    cmd->add_option("--view", a->view, kViewHelp);
     cmd->add_option("--zoom", a->zoom, "Zoom factor (>1 is closer)")->capture_default_str();
     cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
     cmd->add_flag("--ortho", a->ortho, "Orthographic projection");

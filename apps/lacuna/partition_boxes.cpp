@@ -1,4 +1,5 @@
 #include "partition_boxes.h"
+#include "lacuna/orientation.h"
 
 #include <algorithm>
 #include <cmath>
@@ -152,11 +153,8 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
     OrbitParams op;
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
-    const Box3f bounds{
-        {0, 0, 0},
-        {float(double(d.x - 1) * vol.spacing.x), float(double(d.y - 1) * vol.spacing.y),
-         float(double(d.z - 1) * vol.spacing.z)}};
-    const Camera cam = Camera::orbit(bounds, op, 64, 64);
+    const Camera cam = to_volume_frame(volume_frame(vol),
+                                       Camera::orbit(world_bounds(vol), op, 64, 64));
     const Vec3f eye{float(cam.eye().x / vol.spacing.x), float(cam.eye().y / vol.spacing.y),
                     float(cam.eye().z / vol.spacing.z)};
 

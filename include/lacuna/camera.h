@@ -1,5 +1,6 @@
 // Camera: perspective or orthographic, placed by orbit parameters around a target.
-// World space is the volume's: x right, y up (index j), z toward the viewer at azimuth 0.
+// World space is patient RAS in mm (lacuna/orientation.h): +x the patient's right, +y anterior,
+// +z superior. The orbit keeps superior up.
 #pragma once
 #include <string>
 
@@ -14,7 +15,9 @@ struct Ray {
     Vec3f dir;  // unit length
 };
 
-// Orbit placement. Azimuth rotates about the world y axis, elevation lifts toward +y.
+// Orbit placement around the superior (+z) axis, from the anterior view: azimuth 0, elevation 0
+// looks at the face from the front (the eye on +y, looking toward -y), azimuth 90 from the
+// patient's left, 180 from behind, 270 from the right; elevation lifts the eye toward superior.
 // distance <= 0 means "frame the whole bounds" (the default); zoom > 1 moves closer.
 struct OrbitParams {
     float azimuth_deg = 30.f;
@@ -32,6 +35,11 @@ public:
     Camera() = default;
     // A camera that sees all of `bounds` (world box) for the given image size.
     static Camera orbit(const Box3f& bounds, const OrbitParams& p, int width, int height);
+
+    // A camera from its eye and screen basis (right, up: the image's x and y directions; they need
+    // not be right-handed with forward, e.g. after a mirroring map into a volume frame).
+    static Camera from_basis(Vec3f eye, Vec3f forward, Vec3f right, Vec3f up, float half_height,
+                             int width, int height, Projection projection);
 
     // The ray through the centre of pixel (px, py); py = 0 is the top row.
     Ray generate(float px, float py) const;

@@ -6,9 +6,10 @@
 //   cell          cell (i,j,k) is the cube between voxels i..i+1, j..j+1, k..k+1; there are
 //                 (dims-1) cells per axis. A trilinear sample in a cell lies between the min and
 //                 max of its 8 corner voxels, which is why skipping structures work per cell.
-//   world space   index * spacing (millimetres). Origin and direction are kept for writers and
-//                 for `lacuna info`; the renderers place the volume axis-aligned with its first
-//                 voxel at the world origin (docs/architecture.md).
+//   world space   patient RAS in millimetres: world = direction * (index * spacing) + origin,
+//                 with direction and origin stored in ITK's LPS+ form (lacuna/orientation.h
+//                 converts, docs/formats.md "World frame"). The defaults (geometry never set:
+//                 synthetic volumes, raw files) make world = index * spacing.
 //
 // Visualization range (bitfield paper, Section 3.1): the interval of voxel values that the
 // transfer function's domain [0,1] maps onto. Data min..max by default, overridable.
@@ -73,8 +74,15 @@ public:
     void set_value(int i, int j, int k, float v);
 
     Vec3d spacing{1, 1, 1};  // mm between voxel centres
-    Vec3d origin{0, 0, 0};   // world position of voxel (0,0,0), as stored in the file
-    double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major direction cosines
+    // Geometry in ITK's LPS+ convention (x toward the patient's left, y posterior, z superior),
+    // whatever the file's own convention: the world position of voxel (0,0,0), and the
+    // row-major direction cosines (column c = the LPS direction of index axis c). The default
+    // LPS diag(-1, -1, 1) is RAS identity: world = index * spacing.
+    Vec3d origin{0, 0, 0};
+    double direction[9] = {-1, 0, 0, 0, -1, 0, 0, 0, 1};
+    // Where the geometry came from, for `lacuna info` ("NIfTI sform (code 1, scanner)", "DICOM
+    // ImageOrientationPatient/ImagePositionPatient", ...); empty: none (index * spacing).
+    std::string geometry_source;
 
     // Scans the voxels: sets data_range (and vis_range if it was never set: the data range, or
     // [min, min+1] when that is empty or too narrow for the LUT, see lut_range_ok). For float32,

@@ -269,6 +269,18 @@ double checked_slice_step(const std::vector<SliceInfo>& slices,
                             ", the slices are " + mm(std::fabs(step)) +
                             " apart on average (a missing or extra slice?)");
     }
+    // Each slice must lie on the line through the first along the normal: a position off it
+    // (a tilted or sheared stack, or slices of another orientation) has no rigid index-to-world
+    // map. The same tolerance as the step, across the normal.
+    for (size_t i = 1; i < n; ++i) {
+        const Vec3d off = slices[i].origin - slices[0].origin;
+        const Vec3d across = off - normal * p[i];
+        if (length(across) > 0.01 * std::fabs(step) * double(i) + 1e-3)
+            throw Error(dir, file_name(files[i]),
+                        "ImagePositionPatient is " + mm(length(across)) + " off the slice normal "
+                        "through " + file_name(files[0]) +
+                            " (contradictory slice positions: a sheared or tilted stack)");
+    }
     return step;
 }
 
@@ -452,6 +464,9 @@ Volume read_dicom_dir(const std::string& dir, const ReadOptions& opts) {
         v.spacing[a] = h.spacing[a];
     }
     for (int i = 0; i < 9; ++i) v.direction[i] = h.direction[i];
+    v.geometry_source =
+        "DICOM ImageOrientationPatient and ImagePositionPatient (read by GDCM, LPS), slices "
+        "ordered along the normal";
     return v;
 }
 

@@ -76,6 +76,16 @@ void copy_geometry(const itk::ImageIOBase& io, Volume& v) {
     }
 }
 
+// What copy_geometry read, for `lacuna info`: ITK turns NRRD's space/space directions/space
+// origin and MetaImage's TransformMatrix/Offset into LPS direction and origin (a file without
+// them reads as LPS identity, as in ITK-based tools).
+std::string geometry_source(const std::string& path) {
+    const std::string f = format_name(path);
+    if (f == "NRRD") return "NRRD space directions and space origin (read by ITK, LPS)";
+    if (f == "MetaImage") return "MetaImage TransformMatrix and Offset (read by ITK, LPS)";
+    return "ITK image direction and origin (LPS)";
+}
+
 }  // namespace
 
 Volume read_itk(const std::string& path, const ReadOptions& opts) {
@@ -151,6 +161,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
 
     Volume v(dims, stored_type(disk), path);
     copy_geometry(*io, v);
+    v.geometry_source = geometry_source(path);
     if (meta) {
         quiet.reset();
         read_metaimage_voxels(*meta, disk, v, path, opts.progress);

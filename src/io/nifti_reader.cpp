@@ -35,6 +35,7 @@
 #include "io/io_util.h"
 #include "io/readers.h"
 #include "lacuna/error.h"
+#include "lacuna/orientation.h"
 
 namespace lacuna::io {
 
@@ -330,31 +331,96 @@ bool similar(const Affine& a, const Affine& b, double tol) {
     return true;
 }
 
+double determinant(const Affine& a) {
+    const auto& m = a.m;
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+std::string form_code_name(int code) {
+    switch (code) {
+        case 1: return "scanner";
+        case 2: return "aligned";
+        case 3: return "talairach";
+        case 4: return "mni";
+        case 5: return "template";
+        default: return "unknown";
+    }
+}
+
 // Sets spacing, origin and direction (LPS+) from the header, choosing between qform and sform
 // the way ITK's NiftiImageIO does, so a file reads the same here as in ITK-based tools:
-//   neither code set                       -> origin 0, identity direction
+//   neither code set                       -> pixdim only: RAS-aligned, origin 0 (as nibabel and
+//                                             niftilib's method 1; world = index * spacing)
 //   sform rigid and (qform unknown, or sform_code SCANNER_ANAT, or sform ~= qform) -> sform
 //   otherwise, qform code set              -> qform
-//   otherwise (only a sheared sform)       -> the sform with normalised columns
-// Spacing always comes from pixdim, as in ITK.
-void set_geometry(const NiftiHeader& h, Volume& v) {
+//   otherwise (only a sheared sform)       -> refused: lacuna does not render sheared grids
+// Spacing always comes from pixdim, as in ITK. A transform whose code is set but whose numbers
+// are unusable (NaN quaternion or offset, non-finite, zero or singular sform) is an error naming
+// the field, not silently replaced by another transform. Records the choice in geometry_source.
+void set_geometry(const NiftiHeader& h, Volume& v, const std::string& path) {
     v.spacing = {positive_or_one(std::fabs(h.pixdim[1])), positive_or_one(std::fabs(h.pixdim[2])),
                  positive_or_one(std::fabs(h.pixdim[3]))};
-    const bool have_q =
-        h.qform_code > 0 && std::isfinite(h.quatern[0] + h.quatern[1] + h.quatern[2]);
-    const bool have_s = h.sform_code > 0 && finite_affine(sform_affine(h));
+    auto nums = [](const double* x, int n) {
+        std::string t;
+        for (int i = 0; i < n; ++i) t += (i ? " " : "") + std::to_string(x[i]);
+        return t;
+    };
+    const bool have_q = h.qform_code > 0;
+    const bool have_s = h.sform_code > 0;
+    if (have_q) {
+        if (!std::isfinite(h.quatern[0] + h.quatern[1] + h.quatern[2]))
+            throw Error(path, "quatern_b/c/d",
+                        "qform_code is " + std::to_string(h.qform_code) +
+                            " but the quaternion is not finite: " + nums(h.quatern, 3));
+        if (!std::isfinite(h.qoffset[0] + h.qoffset[1] + h.qoffset[2]))
+            throw Error(path, "qoffset_x/y/z",
+                        "qform_code is " + std::to_string(h.qform_code) +
+                            " but the offset is not finite: " + nums(h.qoffset, 3));
+        if (!std::isfinite(h.pixdim[0]))
+            throw Error(path, "pixdim[0]", "the qform's qfac is not finite");
+    }
+    const Affine s = sform_affine(h);
+    if (have_s) {
+        static const char* rows[3] = {"srow_x", "srow_y", "srow_z"};
+        for (int r = 0; r < 3; ++r)
+            if (!std::isfinite(s.t[r] + s.m[r][0] + s.m[r][1] + s.m[r][2]))
+                throw Error(path, rows[r],
+                            "sform_code is " + std::to_string(h.sform_code) +
+                                " but the row is not finite: " + nums(h.srow[r], 4));
+        const double scale = s.column_norm(0) * s.column_norm(1) * s.column_norm(2);
+        if (!(std::fabs(determinant(s)) > 1e-12 * scale) || !(scale > 0))
+            throw Error(path, "srow_x/y/z",
+                        "sform_code is " + std::to_string(h.sform_code) +
+                            " but the sform is singular (a zero axis or axes in one plane): [" +
+                            nums(h.srow[0], 4) + "] [" + nums(h.srow[1], 4) + "] [" +
+                            nums(h.srow[2], 4) + "]");
+    }
     if (!have_q && !have_s) {
         v.origin = {0, 0, 0};
-        for (int i = 0; i < 9; ++i) v.direction[i] = i % 4 == 0 ? 1.0 : 0.0;
+        const double ras_identity_in_lps[9] = {-1, 0, 0, 0, -1, 0, 0, 0, 1};
+        for (int i = 0; i < 9; ++i) v.direction[i] = ras_identity_in_lps[i] + 0.0;
+        v.geometry_source = "NIfTI pixdim only (qform_code and sform_code 0)";
         return;
     }
-    const Affine q = qform_affine(h), s = sform_affine(h);
+    const Affine q = have_q ? qform_affine(h) : Affine{};
     bool use_s = false;
     if (have_s && is_rigid(s)) {
         constexpr int kScannerAnat = 1;
         use_s = !have_q || h.sform_code == kScannerAnat || similar(q, s, 1e-4);
     }
-    const Affine& m = use_s || !have_q ? s : q;
+    if (have_s && !use_s && !have_q)
+        throw Error(path, "srow_x/y/z",
+                    "the sform is sheared (its axes are not perpendicular) and there is no qform "
+                    "to fall back on; lacuna does not render sheared grids");
+    const Affine& m = use_s ? s : q;
+    v.geometry_source =
+        use_s ? "NIfTI sform (sform_code " + std::to_string(h.sform_code) + ", " +
+                    form_code_name(h.sform_code) + ")"
+              : "NIfTI qform (qform_code " + std::to_string(h.qform_code) + ", " +
+                    form_code_name(h.qform_code) + ")" +
+                    (have_s ? std::string(is_rigid(s) ? ", the sform differs" : ", the sform is sheared") : "");
     // RAS+ -> LPS+: flip the first two world axes. "+ 0.0" turns -0 into 0 for printouts.
     const double flip[3] = {-1.0, -1.0, 1.0};
     for (int col = 0; col < 3; ++col) {
@@ -362,8 +428,7 @@ void set_geometry(const NiftiHeader& h, Volume& v) {
         for (int row = 0; row < 3; ++row)
             v.direction[row * 3 + col] = (n > 0 ? flip[row] * m.m[row][col] / n : 0.0) + 0.0;
     }
-    for (int row = 0; row < 3; ++row)
-        v.origin[row] = (std::isfinite(m.t[row]) ? flip[row] * m.t[row] : 0.0) + 0.0;
+    for (int row = 0; row < 3; ++row) v.origin[row] = flip[row] * m.t[row] + 0.0;
 }
 
 }  // namespace
@@ -402,7 +467,8 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     }
 
     Volume v(dims, type, path);
-    set_geometry(h, v);
+    set_geometry(h, v, path);
+    check_geometry(v, path);  // before the voxels are read
     if (gzseek(f.get(), z_off_t(h.vox_offset), SEEK_SET) != z_off_t(h.vox_offset))
         throw Error(path, "voxel data",
                     "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));

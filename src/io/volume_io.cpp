@@ -7,6 +7,7 @@
 #include "io/readers.h"
 #include "lacuna/error.h"
 #include "lacuna/io.h"
+#include "lacuna/orientation.h"
 
 namespace lacuna {
 
@@ -30,6 +31,7 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
             else
                 v = io::read_itk(path, opts);
         }
+        check_geometry(v, path);  // one world frame: no zero, singular or sheared axes
         v.compute_range(path);
     } catch (const Error&) {
         throw;

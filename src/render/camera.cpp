@@ -4,9 +4,10 @@
 
 namespace lacuna {
 
-// World "up" is +z: medical volumes store the superior direction along the third index axis
-// (NIfTI RAS/LPS), so heads stand upright. Azimuth turns about z, elevation lifts toward +z;
-// azimuth 0, elevation 0 looks along +y (from the -y side toward the target).
+// World "up" is +z, superior in patient RAS (lacuna/orientation.h), so heads stand upright.
+// Azimuth turns about z, elevation lifts toward +z; azimuth 0, elevation 0 is the anterior view
+// (the eye on the +y side looking along -y), azimuth 90 the left view (eye on -x). Looking
+// straight down or up, "up" on the screen is anterior (+y).
 Camera Camera::orbit(const Box3f& bounds, const OrbitParams& p, int width, int height) {
     Camera c;
     c.m_width = width;
@@ -17,7 +18,7 @@ Camera Camera::orbit(const Box3f& bounds, const OrbitParams& p, int width, int h
     const float az = p.azimuth_deg * float(M_PI) / 180.f;
     const float el = p.elevation_deg * float(M_PI) / 180.f;
     // Direction from the target to the eye.
-    const Vec3f to_eye{std::sin(az) * std::cos(el), -std::cos(az) * std::cos(el), std::sin(el)};
+    const Vec3f to_eye{-std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
     const float half_fov = 0.5f * p.fov_y_deg * float(M_PI) / 180.f;
     const float aspect = float(width) / float(height);
     const float zoom = p.zoom > 0.f ? p.zoom : 1.f;
@@ -36,6 +37,20 @@ Camera Camera::orbit(const Box3f& bounds, const OrbitParams& p, int width, int h
     if (std::abs(dot(world_up, c.m_forward)) > 0.999f) world_up = {0, 1, 0};
     c.m_right = normalize(cross(c.m_forward, world_up));
     c.m_up = cross(c.m_right, c.m_forward);
+    return c;
+}
+
+Camera Camera::from_basis(Vec3f eye, Vec3f forward, Vec3f right, Vec3f up, float half_height,
+                          int width, int height, Projection projection) {
+    Camera c;
+    c.m_eye = eye;
+    c.m_forward = forward;
+    c.m_right = right;
+    c.m_up = up;
+    c.m_half_h = half_height;
+    c.m_width = width;
+    c.m_height = height;
+    c.m_projection = projection;
     return c;
 }
 

@@ -12,6 +12,7 @@
 #include "render/marcher_cache.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
+#include "render/volume_frame.h"
 
 namespace lacuna {
 
@@ -85,7 +86,7 @@ TransferLut union_lut(const TransferLut& a, const TransferLut& b) {
     return u;
 }
 
-Box3f RayMarcher::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; }
+Box3f RayMarcher::bounds() const { return world_bounds(m_volume); }
 
 namespace {
 
@@ -296,8 +297,15 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
 
 }  // namespace
 
-RenderResult RayMarcher::render(const Camera& cam, const RenderOptions& opt) const {
+RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& world_opt) const {
     if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
+    if (!m_back_lut.entries.empty() && world_opt.features.clip_planes.empty())
+        throw Error("--tf-back", "clip plane", "a back TF needs a clip plane (--clip) to split at");
+    // 0. World (RAS) -> the volume frame, where everything below works (lacuna/orientation.h).
+    const VolumeFrame vf = volume_frame(m_volume);
+    const Camera cam = to_volume_frame(vf, world_cam);
+    RenderOptions mapped;
+    const RenderOptions& opt = to_volume_frame(vf, world_opt, mapped);
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
         throw Error("--step", "step", "expected a positive number");
     if (cam.width() < 1 || cam.height() < 1)

@@ -7,6 +7,7 @@
 #include "accel/cell_ranges.h"
 #include "core/parallel.h"
 #include "lacuna/error.h"
+#include "lacuna/orientation.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 
@@ -113,8 +114,9 @@ uint64_t count_tile(const kernel::Grid<T, int64_t>& g, const VisibleCells& cells
 }  // namespace
 
 uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut,
-                                    const VisibleCells& cells, const Camera& cam,
+                                    const VisibleCells& cells, const Camera& world_cam,
                                     const RenderOptions& opt) {
+    const Camera cam = to_volume_frame(volume_frame(vol), world_cam);  // as RayMarcher::render
     if (lut.entries.empty()) throw Error("sample analysis", "transfer function", "none was set");
     const Vec3i d = vol.dims();
     if (cells.cells()[0] != d.x - 1 || cells.cells()[1] != d.y - 1 || cells.cells()[2] != d.z - 1)
@@ -141,7 +143,8 @@ uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut, c
     return count_visible_cell_samples(vol, lut, cells, cam, opt);
 }
 
-uint64_t count_lattice_samples(const Volume& vol, const Camera& cam, float step, int threads) {
+uint64_t count_lattice_samples(const Volume& vol, const Camera& world_cam, float step, int threads) {
+    const Camera cam = to_volume_frame(volume_frame(vol), world_cam);  // as RayMarcher::render
     const Vec3i d = vol.dims();
     const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, step);

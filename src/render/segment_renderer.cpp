@@ -16,6 +16,7 @@
 #include "accel/no_accel.h"
 #include "core/parallel.h"
 #include "lacuna/error.h"
+#include "lacuna/orientation.h"
 #include "lacuna/segments.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
@@ -182,10 +183,12 @@ void SegmentRenderer::set_accel(const Accel* accel) {
     m_impl->accel = accel;
 }
 
-Box3f SegmentRenderer::bounds() const { return {{0, 0, 0}, m_impl->labels.world_extent()}; }
+Box3f SegmentRenderer::bounds() const { return world_bounds(m_impl->labels); }
 
-RenderResult SegmentRenderer::render(const Camera& cam, const RenderOptions& opt) const {
+RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOptions& opt) const {
     const Impl& im = *m_impl;
+    // World (RAS) -> the label map's volume frame (lacuna/orientation.h).
+    const Camera cam = to_volume_frame(volume_frame(im.labels), world_cam);
     const bool masked = im.opts.mode == SegmentMode::Masked;
     if (masked && im.lut.entries.empty())
         throw Error("render", "transfer function", "none was set (mask mode)");

@@ -92,7 +92,7 @@ RenderOptions FrameRenderer::render_options(const ViewRequest& req) const {
     ro.threads = m_threads;
     if (req.shading) ro.features.shading = ShadingModel::Phong;  // default light: the headlight
     if (req.clip) {
-        // Keep dot((-1,0,0), p) >= -cx, i.e. x <= cx: the half of the volume with smaller x.
+        // Keep dot((-1,0,0), p) >= -cx, i.e. x <= cx in RAS: the patient's left half.
         const Box3f b = m_marcher->bounds();
         ro.features.clip_planes.push_back(ClipPlane{{-1.f, 0.f, 0.f}, -b.center().x});
     }

@@ -8,6 +8,7 @@
 
 #include "core/parallel.h"
 #include "lacuna/error.h"
+#include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
 #include "render/ray_march_kernel.h"
 #include "slice/polygon.h"
@@ -33,7 +34,7 @@ SliceRenderer::SliceRenderer(const Volume& volume) : m_volume(volume) {}
 
 void SliceRenderer::set_transfer_function(const TransferLut& lut) { m_lut = lut; }
 
-Box3f SliceRenderer::bounds() const { return {{0, 0, 0}, m_volume.world_extent()}; }
+Box3f SliceRenderer::bounds() const { return world_bounds(m_volume); }
 
 namespace {
 
@@ -245,8 +246,10 @@ double cells_of(const Vec3d& lo, const Vec3d& hi) {
 
 }  // namespace
 
-SliceResult SliceRenderer::render(const Camera& cam, const SliceOptions& opt,
+SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& opt,
                                   AdaptiveUpdates* adaptive) const {
+    // World (RAS) -> the volume frame, where the boxes and rays live (lacuna/orientation.h).
+    const Camera cam = to_volume_frame(volume_frame(m_volume), world_cam);
     if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
         throw Error("--step", "step", "expected a positive number");

@@ -25,6 +25,8 @@ struct NiftiSpec {
     double slope = 0, inter = 0;
     int qform_code = 0, sform_code = 0;
     std::array<std::array<double, 4>, 3> srow{};
+    std::array<double, 3> quatern{}, qoffset{};  // quatern_b/c/d, qoffset_x/y/z
+    double qfac = 1;                             // pixdim[0]
     bool big_endian = false;
     std::string magic;       // "" = the right one for the version
     int64_t vox_offset = 0;  // 0 = right after the header (+4 extension bytes)
@@ -66,7 +68,7 @@ inline std::vector<uint8_t> nifti_bytes(const NiftiSpec& s, const void* voxels, 
             std::reverse(out.begin() + long(at), out.begin() + long(at + sizeof value));
     };
     const int64_t dim[8] = {s.ndim, s.dims.x, s.dims.y, s.dims.z, s.dim4, s.dim5, 1, 1};
-    const double pix[8] = {1, s.pixdim.x, s.pixdim.y, s.pixdim.z, 1, 1, 1, 1};
+    const double pix[8] = {s.qfac, s.pixdim.x, s.pixdim.y, s.pixdim.z, 1, 1, 1, 1};
     const int bitpix = s.bitpix ? s.bitpix : nifti_bitpix(s.datatype);
     if (s.version == 1) {
         put(0, int32_t(348));
@@ -79,6 +81,8 @@ inline std::vector<uint8_t> nifti_bytes(const NiftiSpec& s, const void* voxels, 
         put(116, float(s.inter));
         put(252, int16_t(s.qform_code));
         put(254, int16_t(s.sform_code));
+        for (int i = 0; i < 3; ++i) put(256 + 4 * i, float(s.quatern[i]));
+        for (int i = 0; i < 3; ++i) put(268 + 4 * i, float(s.qoffset[i]));
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 4; ++c) put(280 + 16 * r + 4 * c, float(s.srow[r][c]));
         const std::string magic = s.magic.empty() ? std::string("n+1\0", 4) : s.magic;
@@ -96,6 +100,8 @@ inline std::vector<uint8_t> nifti_bytes(const NiftiSpec& s, const void* voxels, 
         put(184, s.inter);
         put(344, int32_t(s.qform_code));
         put(348, int32_t(s.sform_code));
+        for (int i = 0; i < 3; ++i) put(352 + 8 * i, s.quatern[i]);
+        for (int i = 0; i < 3; ++i) put(376 + 8 * i, s.qoffset[i]);
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 4; ++c) put(400 + 32 * r + 8 * c, s.srow[r][c]);
     }

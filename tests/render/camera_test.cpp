@@ -59,14 +59,31 @@ TEST(Camera, RaysAreUnitLengthAndOrthographicRaysParallel) {
     EXPECT_EQ(persp.generate(0, 0).origin, persp.generate(63, 47).origin);
 }
 
-TEST(Camera, AzimuthZeroLooksAlongPlusY) {
+// World is patient RAS (+x right, +y anterior, +z superior): azimuth 0 is the anterior view, the
+// eye in front of the face looking toward posterior, superior up, the patient's right on the
+// screen's left; azimuth 90 looks from the patient's left.
+TEST(Camera, AzimuthZeroIsTheAnteriorViewAndNinetyTheLeftView) {
     const Box3f b{{0, 0, 0}, {10, 10, 10}};
     OrbitParams p;
     p.azimuth_deg = 0;
     p.elevation_deg = 0;
     const Camera cam = Camera::orbit(b, p, 10, 10);
-    EXPECT_NEAR(cam.forward().y, 1.f, 1e-6f);
-    EXPECT_LT(cam.eye().y, 0.f);
+    EXPECT_NEAR(cam.forward().y, -1.f, 1e-6f);
+    EXPECT_GT(cam.eye().y, 10.f);
+    EXPECT_NEAR(cam.up().z, 1.f, 1e-6f);
+    EXPECT_NEAR(cam.right().x, -1.f, 1e-6f);  // screen right = patient's left
+    p.azimuth_deg = 90;
+    const Camera left = Camera::orbit(b, p, 10, 10);
+    EXPECT_NEAR(left.forward().x, 1.f, 1e-6f);
+    EXPECT_LT(left.eye().x, 0.f);
+    EXPECT_NEAR(left.right().y, -1.f, 1e-6f);  // screen right = posterior: the face on the left
+    // Looking straight down: anterior is up on the screen, the patient's right on the right.
+    p.azimuth_deg = 0;
+    p.elevation_deg = 90;
+    const Camera top = Camera::orbit(b, p, 10, 10);
+    EXPECT_NEAR(top.forward().z, -1.f, 1e-6f);
+    EXPECT_NEAR(top.up().y, 1.f, 1e-6f);
+    EXPECT_NEAR(top.right().x, 1.f, 1e-6f);
 }
 
 }  // namespace

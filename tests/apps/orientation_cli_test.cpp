@@ -1,0 +1,155 @@
+// Orientation on the command line (issue 14): `lacuna info` names the world frame, `--view`
+// picks anatomical views, the same anatomy in LPS and RAS files gives the same PNG, and a bad
+// affine is one line naming the file and the field, exit 2, nothing written.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "apps/cli_run.h"
+#include "io/nifti_test_file.h"
+#include "lacuna/image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using lacuna::test::CliResult;
+using lacuna::test::expect_one_line_error;
+
+fs::path temp_dir() {
+    static const fs::path dir = lacuna::test::cli_temp_dir("orient-cli");
+    return dir;
+}
+CliResult run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+
+// A 6x7x8 uint8 NIfTI-1 file with a gradient of values and the given transforms.
+fs::path nifti(const std::string& name, lacuna::test::NiftiSpec s) {
+    s.dims = {6, 7, 8};
+    s.datatype = 2;
+    std::vector<uint8_t> vox(6 * 7 * 8);
+    for (size_t i = 0; i < vox.size(); ++i) vox[i] = uint8_t(i * 7 % 251);
+    const std::vector<uint8_t> bytes = lacuna::test::nifti_bytes(s, vox.data(), vox.size());
+    const fs::path p = temp_dir() / name;
+    std::ofstream(p, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    return p;
+}
+
+lacuna::test::NiftiSpec sform(std::array<std::array<double, 4>, 3> rows, int code = 1) {
+    lacuna::test::NiftiSpec s;
+    s.sform_code = code;
+    s.srow = rows;
+    return s;
+}
+
+TEST(OrientationCli, InfoPrintsTheAffineTheCodeTheTransformAndTheRasBounds) {
+    // LPS storage in a NIfTI sform: i toward the left, j posterior, k superior.
+    lacuna::test::NiftiSpec lps = sform({{{-2, 0, 0, 10}, {0, -1, 0, 20}, {0, 0, 3, -5}}});
+    lps.pixdim = {2, 1, 3};  // spacing comes from pixdim (as in ITK); here it agrees with the sform
+    const fs::path f = nifti("lps.nii", lps);
+    const CliResult r = run("info " + f.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("orientation: LPS"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("NIfTI sform (sform_code 1, scanner)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("[-2 0 0 10] [0 -1 0 20] [0 0 3 -5]"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("x 0 .. 10, y 14 .. 20, z -5 .. 16 mm"), std::string::npos) << r.out;
+    // No transform at all: pixdim only, world = index x spacing.
+    lacuna::test::NiftiSpec none;
+    none.pixdim = {1, 2, 3};
+    const CliResult n = run("info " + nifti("none.nii", none).string());
+    ASSERT_EQ(n.code, 0) << n.err;
+    EXPECT_NE(n.out.find("orientation: RAS"), std::string::npos) << n.out;
+    EXPECT_NE(n.out.find("pixdim only"), std::string::npos) << n.out;
+    EXPECT_NE(n.out.find("x 0 .. 5, y 0 .. 12, z 0 .. 21 mm"), std::string::npos) << n.out;
+}
+
+TEST(OrientationCli, BadAffinesAreOneLineNamingTheFileAndFieldAndWriteNothing) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    lacuna::test::NiftiSpec q;
+    q.qform_code = 1;
+    q.quatern = {nan, 0, 0};
+    lacuna::test::NiftiSpec qo;
+    qo.qform_code = 1;
+    qo.qoffset = {0, INFINITY, 0};
+    lacuna::test::NiftiSpec shear = sform({{{1, 1, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}});
+    const struct {
+        const char* name;
+        lacuna::test::NiftiSpec spec;
+        const char* field;
+    } cases[] = {
+        {"nan-quaternion.nii", q, "quatern_b/c/d"},
+        {"inf-qoffset.nii", qo, "qoffset_x/y/z"},
+        {"zero-sform.nii", sform({{{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}}), "srow_x/y/z"},
+        {"singular-sform.nii", sform({{{1, 2, 0, 0}, {2, 4, 0, 0}, {0, 0, 1, 0}}}), "srow_x/y/z"},
+        {"nan-sform.nii", sform({{{1, 0, 0, 0}, {0, nan, 0, 0}, {0, 0, 1, 0}}}), "srow_y"},
+        {"sheared-sform.nii", shear, "srow_x/y/z"},
+    };
+    for (const auto& c : cases) {
+        const fs::path f = nifti(c.name, c.spec);
+        const fs::path png = temp_dir() / (std::string(c.name) + ".png");
+        const CliResult r = run("render " + f.string() + " --tf mr-default --size 16 --out " + png.string());
+        expect_one_line_error(r, f.string() + ": " + c.field + ":");
+        EXPECT_FALSE(fs::exists(png)) << c.name;
+        expect_one_line_error(run("info " + f.string()), c.field);
+    }
+}
+
+TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng) {
+    // One anatomy twice: RAS storage, and the same voxels mirrored in i and j stored as LPS.
+    lacuna::test::NiftiSpec ras = sform({{{1, 0, 0, -2.5}, {0, 1, 0, -3}, {0, 0, 1, -3.5}}});
+    const fs::path a = nifti("ras.nii", ras);
+    {
+        // The mirrored copy: voxel (i,j,k) of b is voxel (5-i, 6-j, k) of a.
+        std::vector<uint8_t> va(6 * 7 * 8), vb(va.size());
+        for (size_t i = 0; i < va.size(); ++i) va[i] = uint8_t(i * 7 % 251);
+        for (int k = 0; k < 8; ++k)
+            for (int j = 0; j < 7; ++j)
+                for (int i = 0; i < 6; ++i) vb[size_t((k * 7 + j) * 6 + i)] = va[size_t((k * 7 + 6 - j) * 6 + 5 - i)];
+        lacuna::test::NiftiSpec lps = sform({{{-1, 0, 0, 2.5}, {0, -1, 0, 3}, {0, 0, 1, -3.5}}});
+        lps.dims = {6, 7, 8};
+        lps.datatype = 2;
+        const std::vector<uint8_t> bytes = lacuna::test::nifti_bytes(lps, vb.data(), vb.size());
+        std::ofstream(temp_dir() / "lps-mirror.nii", std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    const fs::path b = temp_dir() / "lps-mirror.nii";
+    for (const char* view : {"anterior", "left", "superior"}) {
+        const fs::path pa = temp_dir() / (std::string("ras-") + view + ".png"),
+                       pb = temp_dir() / (std::string("lps-") + view + ".png");
+        const std::string common = std::string(" --tf mr-default --size 32 --ortho --view ") + view;
+        ASSERT_EQ(run("render " + a.string() + common + " --out " + pa.string()).code, 0);
+        ASSERT_EQ(run("render " + b.string() + common + " --out " + pb.string()).code, 0);
+        ASSERT_TRUE(fs::exists(pa) && fs::exists(pb));
+        // Mirrored lattices: the same picture up to float rounding of the sample positions.
+        const lacuna::Image ia = lacuna::read_png(pa.string()), ib = lacuna::read_png(pb.string());
+        ASSERT_EQ(ia.rgba.size(), ib.rgba.size());
+        size_t close = 0, lit = 0;
+        for (size_t p = 0; p < ia.rgba.size(); p += 4) {
+            int m = 0;
+            for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(int(ia.rgba[p + c]) - int(ib.rgba[p + c])));
+            close += m <= 1;
+            lit += ia.rgba[p + 3] > 0;
+        }
+        EXPECT_GE(double(close), 0.999 * double(ia.rgba.size() / 4)) << view;
+        EXPECT_GT(lit, 50u) << view << ": the volume is in the picture";
+    }
+    // --view anterior is azimuth 0, elevation 0.
+    const fs::path v1 = temp_dir() / "view.png", v2 = temp_dir() / "angles.png";
+    ASSERT_EQ(run("render " + a.string() + " --tf mr-default --size 24 --view left --out " + v1.string()).code, 0);
+    ASSERT_EQ(run("render " + a.string() + " --tf mr-default --size 24 --azimuth 90 --elevation 0 --out " + v2.string()).code, 0);
+    EXPECT_EQ(lacuna::test::slurp_file(v1), lacuna::test::slurp_file(v2));
+    const fs::path bad = temp_dir() / "bad-view.png";
+    expect_one_line_error(run("render " + a.string() + " --tf mr-default --view frontal --out " + bad.string()),
+                          "--view");
+    expect_one_line_error(run("render " + a.string() + " --tf mr-default --view left --azimuth 3 --out " + bad.string()),
+                          "--view");
+    EXPECT_FALSE(fs::exists(bad));
+}
+
+}  // namespace
