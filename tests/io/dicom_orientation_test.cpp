@@ -13,15 +13,20 @@
 namespace lacuna {
 namespace {
 
-// Offset of the value of element (0020,0032) ImagePositionPatient in an explicit-VR little
-// endian file, or npos.
-size_t ipp_value(const std::vector<uint8_t>& f, uint16_t& length) {
-    const uint8_t tag[6] = {0x20, 0x00, 0x32, 0x00, 'D', 'S'};
-    for (size_t i = 132; i + 8 < f.size(); ++i)
-        if (std::memcmp(&f[i], tag, 6) == 0) {
-            length = uint16_t(f[i + 6] | (f[i + 7] << 8));
-            return i + 8;
+// Offset of the value of element (0020,0032) ImagePositionPatient in a little-endian file
+// (explicit VR "DS" + 2-byte length, or implicit VR: a 4-byte length), or npos.
+size_t ipp_value(const std::vector<uint8_t>& f, uint32_t& length) {
+    const uint8_t tag[4] = {0x20, 0x00, 0x32, 0x00};
+    for (size_t i = 132; i + 8 < f.size(); ++i) {
+        if (std::memcmp(&f[i], tag, 4) != 0) continue;
+        if (f[i + 4] == 'D' && f[i + 5] == 'S') {
+            length = uint32_t(f[i + 6] | (f[i + 7] << 8));
+        } else {
+            length = uint32_t(f[i + 4] | (f[i + 5] << 8) | (f[i + 6] << 16) | (uint32_t(f[i + 7]) << 24));
         }
+        if (length < 5 || i + 8 + length > f.size()) continue;
+        return i + 8;
+    }
     return std::string::npos;
 }
 
@@ -53,22 +58,25 @@ TEST(DicomOrientation, ASliceOffTheNormalIsContradictorySlicePositions) {
     const Volume v = test::pattern_volume({8, 8, 5}, VoxelType::Int16);
     write_volume(dir.file("s") + "/", v);
     ASSERT_NO_THROW(read_volume(dir.file("s")));
-    // Move slice 3 sideways: its x position "0" becomes "9" (same length, so the file stays
-    // well formed), its position along the normal is unchanged.
+    // Move slice 3 sideways: the leading digit of its x position changes (same length, so the
+    // file stays well formed), its position along the normal (z) is unchanged.
     const std::string victim = dir.file("s/slice_00003.dcm");
     std::vector<uint8_t> f = test::file_bytes(victim);
-    uint16_t len = 0;
+    uint32_t len = 0;
     const size_t at = ipp_value(f, len);
     ASSERT_NE(at, std::string::npos) << "no ImagePositionPatient in the written slice";
-    ASSERT_EQ(f[at], '0') << std::string(f.begin() + long(at), f.begin() + long(at + len));
-    f[at] = '9';
+    size_t digit = at;
+    while (digit < at + len && !(f[digit] >= '0' && f[digit] <= '9')) ++digit;
+    ASSERT_LT(digit, at + len) << std::string(f.begin() + long(at), f.begin() + long(at + len));
+    f[digit] = f[digit] == '9' ? '1' : '9';
     test::write_bytes(victim, f);
     try {
         read_volume(dir.file("s"));
         ADD_FAILURE() << "a sheared stack was accepted";
     } catch (const Error& e) {
         const std::string m = e.what();
-        EXPECT_NE(m.find("slice_00003.dcm: ImagePositionPatient is 9 mm off the slice normal"),
+        EXPECT_NE(m.find("slice_00003.dcm: ImagePositionPatient is "), std::string::npos) << m;
+        EXPECT_NE(m.find("mm off the slice normal through slice_00000.dcm"),
                   std::string::npos)
             << m;
         EXPECT_NE(m.find("contradictory slice positions"), std::string::npos) << m;
