@@ -288,6 +288,25 @@ TEST(Orientation, EveryVoxelOrderAndFormatOfThePhantomRendersTheSamePicture) {
         for (const Camera& cam : cams)
             expect_same_picture(render(v, cam, lut).image, render(base, cam, lut).image,
                                 var.name, same_order);
+        // World options are world options whatever the storage: a clip plane, a crop box, a
+        // directional light with Phong shading, a spotlight with shadows (all in RAS mm).
+        RenderOptions f;
+        f.features.shading = ShadingModel::Phong;
+        f.features.light.kind = LightKind::Directional;
+        f.features.light.direction = {1, 0.5f, 0.2f};
+        f.features.clip_planes.push_back({{-1, 0, 0}, -6.f});  // keep x <= 6 mm
+        f.features.crop = true;
+        f.features.crop_box = {{-30, -12, -30}, {30, 30, 12}};
+        RenderOptions spot;
+        spot.features.shading = ShadingModel::Pbr;
+        spot.features.light.kind = LightKind::Spot;
+        spot.features.light.position = {40, 50, 40};
+        spot.features.light.target = {0, 0, 0};
+        spot.features.shadows.enabled = true;
+        for (const RenderOptions& o : {f, spot})
+            expect_same_picture(render(v, cams[0], lut, nullptr, o).image,
+                                render(base, cams[0], lut, nullptr, o).image,
+                                std::string(var.name) + " with world features", same_order);
     }
 }
 

@@ -149,6 +149,36 @@ TEST(FrameRenderer, ShadingAndClipTogglesAreTheCliFlags) {
     EXPECT_NE(fr.render(req, 40, 36).image.rgba, cli.rgba) << "the toggles change the picture";
 }
 
+// World is patient RAS (docs/formats.md): on a volume stored LPS with an origin, the page's clip
+// plane is the CLI's --clip in RAS millimetres through the centre of the RAS bounding box, and a
+// named view (azimuth 90: from the patient's left) is the CLI's --view left.
+TEST(FrameRenderer, ClipPlaneAndViewsAreInPatientRasOnAnLpsVolume) {
+    SyntheticOptions so;
+    so.dims = {33, 30, 27};
+    Volume v = generate(SyntheticKind::SphereShells, so);
+    const double lps_identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // RAS x = -(i + 10), y = -(j + 20)
+    for (int i = 0; i < 9; ++i) v.direction[i] = lps_identity[i];
+    v.origin = {10, 20, -5};
+    const fs::path file = temp_dir() / "shells-lps.nrrd";
+    write_volume(file.string(), v);
+    // RAS bounds: x -42 .. -10, so the plane keeps x <= -26: --clip -1,0,0,26.
+    const fs::path out = temp_dir() / "cli_lps_clip.png";
+    const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + file.string() +
+                            " --tf mr-default --accel grid --width 40 --height 36"
+                            " --view left --zoom 1.3 --step 0.5 --ert 1"
+                            " --shading phong --clip -1,0,0,26 --out " + out.string() +
+                            " >/dev/null";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+    FrameRenderer fr(read_volume(file.string()));
+    ViewRequest req = request(AccelKind::Grid, "mr-default");
+    req.camera.azimuth = 90;
+    req.camera.elevation = 0;
+    req.shading = true;
+    req.clip = true;
+    EXPECT_EQ(fr.render(req, 40, 36).image.rgba, read_png(out.string()).rgba);
+}
+
 TEST(FrameRenderer, EveryStructureMatchesNoneThroughTfChangesAndSwitches) {
     SyntheticOptions so;
     so.dims = {25, 21, 19};
