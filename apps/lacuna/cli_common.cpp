@@ -157,8 +157,9 @@ void parse_view(const std::string& name, float& azimuth, float& elevation) {
             elevation = v.elevation;
             return;
         }
-    throw Error("--view", "view",
-                "expected anterior, posterior, left, right, superior or inferior, got '" + name + "'");
+    throw Error(
+        "--view", "view",
+        "expected anterior, posterior, left, right, superior or inferior, got '" + name + "'");
 }
 
 }  // namespace lacuna::cli

@@ -25,8 +25,8 @@ void run(const VolumeArgs& args) {
     std::printf("orientation: %s (the RAS direction +i, +j, +k point toward)\n",
                 orientation_code(v).c_str());
     std::printf("geometry:    %s\n", v.geometry_source.empty()
-                                          ? "none in the file: world = index x spacing"
-                                          : v.geometry_source.c_str());
+                                         ? "none in the file: world = index x spacing"
+                                         : v.geometry_source.c_str());
     std::printf("affine:      RAS mm = [%g %g %g %g] [%g %g %g %g] [%g %g %g %g] * (i, j, k, 1)\n",
                 a.m[0][0], a.m[0][1], a.m[0][2], a.t[0], a.m[1][0], a.m[1][1], a.m[1][2], a.t[1],
                 a.m[2][0], a.m[2][1], a.m[2][2], a.t[2]);

@@ -17,15 +17,15 @@
 
 #include "accel/kdtree_partition.h"
 #include "cli_common.h"
-#include "lacuna/orientation.h"
-#include "partition_boxes.h"
 #include "core/parallel.h"
 #include "io/io_util.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
 #include "lacuna/image.h"
+#include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
+#include "partition_boxes.h"
 
 namespace lacuna::cli {
 
@@ -403,7 +403,8 @@ void register_partition(CLI::App& app) {
     cmd->callback([a, cmd] {
         if (!a->view.empty()) {
             if (cmd->count("--azimuth") || cmd->count("--elevation"))
-                throw Error("--view", "view", "sets the azimuth and elevation; drop --azimuth/--elevation");
+                throw Error("--view", "view",
+                            "sets the azimuth and elevation; drop --azimuth/--elevation");
             parse_view(a->view, a->azimuth, a->elevation);
         }
         run(*a);

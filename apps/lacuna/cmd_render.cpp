@@ -95,7 +95,8 @@ struct Setup {
 Setup validate(RenderArgs& a) {
     if (!a.view.empty()) {
         if (a.azimuth_given || a.elevation_given)
-            throw Error("--view", "view", "sets the azimuth and elevation; drop --azimuth/--elevation");
+            throw Error("--view", "view",
+                        "sets the azimuth and elevation; drop --azimuth/--elevation");
         parse_view(a.view, a.azimuth, a.elevation);
         a.azimuth_given = a.elevation_given = true;
     }

@@ -1,5 +1,4 @@
 #include "partition_boxes.h"
-#include "lacuna/orientation.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include "lacuna/camera.h"
 #include "lacuna/error.h"
 #include "lacuna/image.h"
+#include "lacuna/orientation.h"
 #include "lacuna/transfer_function.h"
 #include "slice/growing_boxes_source.h"
 
@@ -153,8 +153,8 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
     OrbitParams op;
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
-    const Camera cam = to_volume_frame(volume_frame(vol),
-                                       Camera::orbit(world_bounds(vol), op, 64, 64));
+    const Camera cam =
+        to_volume_frame(volume_frame(vol), Camera::orbit(world_bounds(vol), op, 64, 64));
     const Vec3f eye{float(cam.eye().x / vol.spacing.x), float(cam.eye().y / vol.spacing.y),
                     float(cam.eye().z / vol.spacing.z)};
 

@@ -53,7 +53,7 @@ void check_geometry(const Volume& v, const std::string& where);
 // is exactly the identity (no orientation), so callers can skip it and keep every bit.
 struct VolumeFrame {
     double rot[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // R^T: rows are the index axes in world
-    Vec3d from{0, 0, 0};                                     // the world position of voxel (0,0,0)
+    Vec3d from{0, 0, 0};                                   // the world position of voxel (0,0,0)
     bool identity = true;
     Vec3f point(Vec3f world) const;   // world point -> volume frame
     Vec3f vector(Vec3f world) const;  // world direction -> volume frame

@@ -277,8 +277,10 @@ double checked_slice_step(const std::vector<SliceInfo>& slices,
         const Vec3d across = off - normal * p[i];
         if (length(across) > 0.01 * std::fabs(step) * double(i) + 1e-3)
             throw Error(dir, file_name(files[i]),
-                        "ImagePositionPatient is " + mm(length(across)) + " off the slice normal "
-                        "through " + file_name(files[0]) +
+                        "ImagePositionPatient is " + mm(length(across)) +
+                            " off the slice normal "
+                            "through " +
+                            file_name(files[0]) +
                             " (contradictory slice positions: a sheared or tilted stack)");
     }
     return step;

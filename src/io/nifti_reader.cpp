@@ -340,12 +340,18 @@ double determinant(const Affine& a) {
 
 std::string form_code_name(int code) {
     switch (code) {
-        case 1: return "scanner";
-        case 2: return "aligned";
-        case 3: return "talairach";
-        case 4: return "mni";
-        case 5: return "template";
-        default: return "unknown";
+        case 1:
+            return "scanner";
+        case 2:
+            return "aligned";
+        case 3:
+            return "talairach";
+        case 4:
+            return "mni";
+        case 5:
+            return "template";
+        default:
+            return "unknown";
     }
 }
 
@@ -415,12 +421,13 @@ void set_geometry(const NiftiHeader& h, Volume& v, const std::string& path) {
                     "the sform is sheared (its axes are not perpendicular) and there is no qform "
                     "to fall back on; lacuna does not render sheared grids");
     const Affine& m = use_s ? s : q;
-    v.geometry_source =
-        use_s ? "NIfTI sform (sform_code " + std::to_string(h.sform_code) + ", " +
-                    form_code_name(h.sform_code) + ")"
-              : "NIfTI qform (qform_code " + std::to_string(h.qform_code) + ", " +
-                    form_code_name(h.qform_code) + ")" +
-                    (have_s ? std::string(is_rigid(s) ? ", the sform differs" : ", the sform is sheared") : "");
+    v.geometry_source = use_s ? "NIfTI sform (sform_code " + std::to_string(h.sform_code) + ", " +
+                                    form_code_name(h.sform_code) + ")"
+                              : "NIfTI qform (qform_code " + std::to_string(h.qform_code) + ", " +
+                                    form_code_name(h.qform_code) + ")" +
+                                    (have_s ? std::string(is_rigid(s) ? ", the sform differs"
+                                                                      : ", the sform is sheared")
+                                            : "");
     // RAS+ -> LPS+: flip the first two world axes. "+ 0.0" turns -0 into 0 for printouts.
     const double flip[3] = {-1.0, -1.0, 1.0};
     for (int col = 0; col < 3; ++col) {

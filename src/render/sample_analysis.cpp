@@ -143,7 +143,8 @@ uint64_t count_visible_cell_samples(const Volume& vol, const TransferLut& lut, c
     return count_visible_cell_samples(vol, lut, cells, cam, opt);
 }
 
-uint64_t count_lattice_samples(const Volume& vol, const Camera& world_cam, float step, int threads) {
+uint64_t count_lattice_samples(const Volume& vol, const Camera& world_cam, float step,
+                               int threads) {
     const Camera cam = to_volume_frame(volume_frame(vol), world_cam);  // as RayMarcher::render
     const Vec3i d = vol.dims();
     const Vec3f inv_sp = inverse_spacing(vol);

@@ -183,7 +183,9 @@ void SegmentRenderer::set_accel(const Accel* accel) {
     m_impl->accel = accel;
 }
 
-Box3f SegmentRenderer::bounds() const { return world_bounds(m_impl->labels); }
+Box3f SegmentRenderer::bounds() const {
+    return world_bounds(m_impl->labels);
+}
 
 RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOptions& opt) const {
     const Impl& im = *m_impl;

@@ -23,7 +23,7 @@ FeatureOptions to_volume_frame(const VolumeFrame& f, const FeatureOptions& world
             for (int a = 0; a < 3; ++a) {
                 Vec3f n{0, 0, 0};
                 n[a] = 1.f;
-                v.clip_planes.push_back(plane(n, b.lo[a]));   // x_a >= lo
+                v.clip_planes.push_back(plane(n, b.lo[a]));  // x_a >= lo
                 n[a] = -1.f;
                 v.clip_planes.push_back(plane(n, -b.hi[a]));  // x_a <= hi
             }

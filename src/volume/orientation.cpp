@@ -107,18 +107,18 @@ void check_geometry(const Volume& v, const std::string& where) {
     };
     for (int a = 0; a < 3; ++a)
         if (!(std::fabs(col_dot(a, a) - 1.0) < 1e-4))
-            throw Error(where, "direction",
-                        "axis " + std::to_string(a) + " has length " +
-                            num(std::sqrt(col_dot(a, a))) +
-                            ", expected unit direction cosines (a zero or singular matrix?): " + dir);
+            throw Error(
+                where, "direction",
+                "axis " + std::to_string(a) + " has length " + num(std::sqrt(col_dot(a, a))) +
+                    ", expected unit direction cosines (a zero or singular matrix?): " + dir);
     for (int a = 0; a < 3; ++a)
         for (int b = a + 1; b < 3; ++b)
             if (!(std::fabs(col_dot(a, b)) < 1e-4))
-                throw Error(where, "direction",
-                            "axes " + std::to_string(a) + " and " + std::to_string(b) +
-                                " are not perpendicular (cos " + num(col_dot(a, b)) +
-                                "): a sheared or singular grid, which lacuna does not render: " +
-                                dir);
+                throw Error(
+                    where, "direction",
+                    "axes " + std::to_string(a) + " and " + std::to_string(b) +
+                        " are not perpendicular (cos " + num(col_dot(a, b)) +
+                        "): a sheared or singular grid, which lacuna does not render: " + dir);
 }
 
 Vec3f VolumeFrame::point(Vec3f p) const {

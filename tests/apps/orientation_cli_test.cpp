@@ -26,7 +26,9 @@ fs::path temp_dir() {
     static const fs::path dir = lacuna::test::cli_temp_dir("orient-cli");
     return dir;
 }
-CliResult run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliResult run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 // A 6x7x8 uint8 NIfTI-1 file with a gradient of values and the given transforms.
 fs::path nifti(const std::string& name, lacuna::test::NiftiSpec s) {
@@ -93,7 +95,8 @@ TEST(OrientationCli, BadAffinesAreOneLineNamingTheFileAndFieldAndWriteNothing) {
     for (const auto& c : cases) {
         const fs::path f = nifti(c.name, c.spec);
         const fs::path png = temp_dir() / (std::string(c.name) + ".png");
-        const CliResult r = run("render " + f.string() + " --tf mr-default --size 16 --out " + png.string());
+        const CliResult r =
+            run("render " + f.string() + " --tf mr-default --size 16 --out " + png.string());
         expect_one_line_error(r, f.string() + ": " + c.field + ":");
         EXPECT_FALSE(fs::exists(png)) << c.name;
         expect_one_line_error(run("info " + f.string()), c.field);
@@ -110,7 +113,8 @@ TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng)
         for (size_t i = 0; i < va.size(); ++i) va[i] = uint8_t(i * 7 % 251);
         for (int k = 0; k < 8; ++k)
             for (int j = 0; j < 7; ++j)
-                for (int i = 0; i < 6; ++i) vb[size_t((k * 7 + j) * 6 + i)] = va[size_t((k * 7 + 6 - j) * 6 + 5 - i)];
+                for (int i = 0; i < 6; ++i)
+                    vb[size_t((k * 7 + j) * 6 + i)] = va[size_t((k * 7 + 6 - j) * 6 + 5 - i)];
         lacuna::test::NiftiSpec lps = sform({{{-1, 0, 0, 2.5}, {0, -1, 0, 3}, {0, 0, 1, -3.5}}});
         lps.dims = {6, 7, 8};
         lps.datatype = 2;
@@ -132,7 +136,8 @@ TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng)
         size_t close = 0, lit = 0;
         for (size_t p = 0; p < ia.rgba.size(); p += 4) {
             int m = 0;
-            for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(int(ia.rgba[p + c]) - int(ib.rgba[p + c])));
+            for (int c = 0; c < 4; ++c)
+                m = std::max(m, std::abs(int(ia.rgba[p + c]) - int(ib.rgba[p + c])));
             close += m <= 1;
             lit += ia.rgba[p + 3] > 0;
         }
@@ -141,13 +146,21 @@ TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng)
     }
     // --view anterior is azimuth 0, elevation 0.
     const fs::path v1 = temp_dir() / "view.png", v2 = temp_dir() / "angles.png";
-    ASSERT_EQ(run("render " + a.string() + " --tf mr-default --size 24 --view left --out " + v1.string()).code, 0);
-    ASSERT_EQ(run("render " + a.string() + " --tf mr-default --size 24 --azimuth 90 --elevation 0 --out " + v2.string()).code, 0);
+    ASSERT_EQ(
+        run("render " + a.string() + " --tf mr-default --size 24 --view left --out " + v1.string())
+            .code,
+        0);
+    ASSERT_EQ(run("render " + a.string() +
+                  " --tf mr-default --size 24 --azimuth 90 --elevation 0 --out " + v2.string())
+                  .code,
+              0);
     EXPECT_EQ(lacuna::test::slurp_file(v1), lacuna::test::slurp_file(v2));
     const fs::path bad = temp_dir() / "bad-view.png";
-    expect_one_line_error(run("render " + a.string() + " --tf mr-default --view frontal --out " + bad.string()),
-                          "--view");
-    expect_one_line_error(run("render " + a.string() + " --tf mr-default --view left --azimuth 3 --out " + bad.string()),
+    expect_one_line_error(
+        run("render " + a.string() + " --tf mr-default --view frontal --out " + bad.string()),
+        "--view");
+    expect_one_line_error(run("render " + a.string() +
+                              " --tf mr-default --view left --azimuth 3 --out " + bad.string()),
                           "--view");
     EXPECT_FALSE(fs::exists(bad));
 }

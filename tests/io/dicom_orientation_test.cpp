@@ -22,7 +22,8 @@ size_t ipp_value(const std::vector<uint8_t>& f, uint32_t& length) {
         if (f[i + 4] == 'D' && f[i + 5] == 'S') {
             length = uint32_t(f[i + 6] | (f[i + 7] << 8));
         } else {
-            length = uint32_t(f[i + 4] | (f[i + 5] << 8) | (f[i + 6] << 16) | (uint32_t(f[i + 7]) << 24));
+            length = uint32_t(f[i + 4] | (f[i + 5] << 8) | (f[i + 6] << 16) |
+                              (uint32_t(f[i + 7]) << 24));
         }
         if (length < 5 || i + 8 + length > f.size()) continue;
         return i + 8;
@@ -76,8 +77,7 @@ TEST(DicomOrientation, ASliceOffTheNormalIsContradictorySlicePositions) {
     } catch (const Error& e) {
         const std::string m = e.what();
         EXPECT_NE(m.find("slice_00003.dcm: ImagePositionPatient is "), std::string::npos) << m;
-        EXPECT_NE(m.find("mm off the slice normal through slice_00000.dcm"),
-                  std::string::npos)
+        EXPECT_NE(m.find("mm off the slice normal through slice_00000.dcm"), std::string::npos)
             << m;
         EXPECT_NE(m.find("contradictory slice positions"), std::string::npos) << m;
         EXPECT_EQ(m.find('\n'), std::string::npos) << m;

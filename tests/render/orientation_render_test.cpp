@@ -32,7 +32,8 @@ using Mat3 = std::array<std::array<double, 3>, 3>;
 void set_ras_direction(Volume& v, const Mat3& r) {
     const double flip[3] = {-1, -1, 1};
     for (int row = 0; row < 3; ++row)
-        for (int col = 0; col < 3; ++col) v.direction[row * 3 + col] = flip[row] * r[row][col] + 0.0;
+        for (int col = 0; col < 3; ++col)
+            v.direction[row * 3 + col] = flip[row] * r[row][col] + 0.0;
 }
 Mat3 ras_direction(const Volume& v) {
     const Affine a = index_to_world(v);
@@ -41,7 +42,9 @@ Mat3 ras_direction(const Volume& v) {
         for (int col = 0; col < 3; ++col) r[row][col] = a.m[row][col] / v.spacing[col];
     return r;
 }
-void set_ras_origin(Volume& v, Vec3d t) { v.origin = {-t.x + 0.0, -t.y + 0.0, t.z}; }
+void set_ras_origin(Volume& v, Vec3d t) {
+    v.origin = {-t.x + 0.0, -t.y + 0.0, t.z};
+}
 
 // A copy of `b` stored in another voxel order: new axis a is b's axis perm[a], reversed when
 // flip[a]. The geometry is rewritten so every voxel keeps its world position.
@@ -55,8 +58,7 @@ Volume reorder(const Volume& b, std::array<int, 3> perm, std::array<bool, 3> fli
             for (int i = 0; i < dv.x; ++i) {
                 const int iv[3] = {i, j, k};
                 int ib[3];
-                for (int a = 0; a < 3; ++a)
-                    ib[perm[a]] = flip[a] ? db[perm[a]] - 1 - iv[a] : iv[a];
+                for (int a = 0; a < 3; ++a) ib[perm[a]] = flip[a] ? db[perm[a]] - 1 - iv[a] : iv[a];
                 v.set_value(i, j, k, b.value(ib[0], ib[1], ib[2]));
             }
     const Affine ab = index_to_world(b);
@@ -106,8 +108,9 @@ TransferLut phantom_lut() {
     TransferFunction tf;
     tf.name = "phantom";
     tf.domain = TfDomain::Value;
-    tf.color = {{0, 0.5, 0.5, 0.5},  {60, 0.5, 0.5, 0.5}, {90, 0.1, 0.2, 1.0}, {110, 0.1, 0.2, 1.0},
-                {150, 0.1, 1.0, 0.2}, {170, 0.1, 1.0, 0.2}, {210, 1.0, 0.1, 0.1}, {255, 1.0, 0.1, 0.1}};
+    tf.color = {{0, 0.5, 0.5, 0.5},   {60, 0.5, 0.5, 0.5},  {90, 0.1, 0.2, 1.0},
+                {110, 0.1, 0.2, 1.0}, {150, 0.1, 1.0, 0.2}, {170, 0.1, 1.0, 0.2},
+                {210, 1.0, 0.1, 0.1}, {255, 1.0, 0.1, 0.1}};
     tf.opacity = {{0, 0}, {35, 0}, {45, 0.03}, {60, 0.03}, {90, 0.9}, {255, 0.9}};
     return discretise(tf, {0, 255});
 }
@@ -137,7 +140,8 @@ Diff compare(const Image& a, const Image& b) {
     d.pixels = size_t(a.width) * size_t(a.height);
     for (size_t p = 0; p < d.pixels; ++p) {
         int m = 0;
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(int(a.rgba[p * 4 + c]) - int(b.rgba[p * 4 + c])));
+        for (int c = 0; c < 4; ++c)
+            m = std::max(m, std::abs(int(a.rgba[p * 4 + c]) - int(b.rgba[p * 4 + c])));
         d.identical += m == 0;
         d.within_one += m <= 1;
         d.max = std::max(d.max, m);
@@ -149,7 +153,9 @@ Diff compare(const Image& a, const Image& b) {
 void expect_same_picture(const Image& got, const Image& want, const std::string& what, bool exact) {
     ASSERT_EQ(got.width, want.width);
     const Diff d = compare(got, want);
-    if (exact) EXPECT_EQ(got.rgba, want.rgba) << what << ": " << d.identical << "/" << d.pixels << " identical";
+    if (exact)
+        EXPECT_EQ(got.rgba, want.rgba)
+            << what << ": " << d.identical << "/" << d.pixels << " identical";
     EXPECT_GE(double(d.within_one), 0.999 * double(d.pixels))
         << what << ": " << d.within_one << "/" << d.pixels << " within 1, max diff " << d.max;
     std::printf("  %s: %zu/%zu pixels identical, %zu within 1, max %d\n", what.c_str(), d.identical,
@@ -216,8 +222,8 @@ void write_nifti(const std::string& path, const Volume& v, NiftiForm form, int v
         s.qoffset = {a.t[0], a.t[1], a.t[2]};
     }
     const std::vector<uint8_t> bytes = test::nifti_bytes(s, v.data(), v.bytes());
-    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                                std::streamsize(bytes.size()));
+    std::ofstream(path, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
 }
 
 struct Variant {
@@ -231,21 +237,51 @@ struct Variant {
 
 // Seven storages of one anatomy (the first is the reference's own order).
 const Variant kVariants[] = {
-    {"RAS NIfTI (ITK writer: sform + qform)", {0, 1, 2}, {false, false, false}, "RAS", "ras.nii.gz", Variant::Itk},
+    {"RAS NIfTI (ITK writer: sform + qform)",
+     {0, 1, 2},
+     {false, false, false},
+     "RAS",
+     "ras.nii.gz",
+     Variant::Itk},
     {"LPS NRRD", {0, 1, 2}, {true, true, false}, "LPS", "lps.nrrd", Variant::Itk},
     {"sagittal PIR MetaImage", {1, 2, 0}, {true, true, false}, "PIR", "pir.mha", Variant::Itk},
-    {"permuted SRA detached NRRD", {2, 0, 1}, {false, false, false}, "SRA", "sra.nhdr", Variant::Itk},
-    {"LPI NIfTI-2 qform only (qfac -1)", {0, 1, 2}, {true, true, true}, "LPI", "lpi.nii", Variant::Qform2},
-    {"coronal LIA NIfTI-1 sform only", {0, 2, 1}, {true, true, false}, "LIA", "lia.nii", Variant::Sform},
-    {"axial LPS DICOM series (IOP 1\\0\\0\\0\\1\\0)", {0, 1, 2}, {true, true, false}, "LPS", "dicom/", Variant::Dicom},
+    {"permuted SRA detached NRRD",
+     {2, 0, 1},
+     {false, false, false},
+     "SRA",
+     "sra.nhdr",
+     Variant::Itk},
+    {"LPI NIfTI-2 qform only (qfac -1)",
+     {0, 1, 2},
+     {true, true, true},
+     "LPI",
+     "lpi.nii",
+     Variant::Qform2},
+    {"coronal LIA NIfTI-1 sform only",
+     {0, 2, 1},
+     {true, true, false},
+     "LIA",
+     "lia.nii",
+     Variant::Sform},
+    {"axial LPS DICOM series (IOP 1\\0\\0\\0\\1\\0)",
+     {0, 1, 2},
+     {true, true, false},
+     "LPS",
+     "dicom/",
+     Variant::Dicom},
 };
 
 Volume write_and_read(const Volume& v, const Variant& var, const test::ScratchDir& dir) {
     const std::string path = dir.file(var.file);
     switch (var.how) {
-        case Variant::Sform: write_nifti(path, v, NiftiForm::SformOnly, 1); break;
-        case Variant::Qform2: write_nifti(path, v, NiftiForm::QformOnly, 2); break;
-        default: write_volume(path, v);
+        case Variant::Sform:
+            write_nifti(path, v, NiftiForm::SformOnly, 1);
+            break;
+        case Variant::Qform2:
+            write_nifti(path, v, NiftiForm::QformOnly, 2);
+            break;
+        default:
+            write_volume(path, v);
     }
     return read_volume(path);
 }
@@ -279,15 +315,16 @@ TEST(Orientation, EveryVoxelOrderAndFormatOfThePhantomRendersTheSamePicture) {
             Vec3d q{};  // the same point in v's index space (a signed permutation: solve per axis)
             for (int c = 0; c < 3; ++c)
                 for (int r = 0; r < 3; ++r)
-                    if (std::fabs(a.m[r][c]) > 0.5 * v.spacing[c]) q[c] = (w[r] - a.t[r]) / a.m[r][c];
+                    if (std::fabs(a.m[r][c]) > 0.5 * v.spacing[c])
+                        q[c] = (w[r] - a.t[r]) / a.m[r][c];
             EXPECT_EQ(v.value(int(std::lround(q.x)), int(std::lround(q.y)), int(std::lround(q.z))),
                       base.value(int(idx.x), int(idx.y), int(idx.z)));
         }
         const bool same_order = var.perm == std::array<int, 3>{0, 1, 2} &&
                                 var.flip == std::array<bool, 3>{false, false, false};
         for (const Camera& cam : cams)
-            expect_same_picture(render(v, cam, lut).image, render(base, cam, lut).image,
-                                var.name, same_order);
+            expect_same_picture(render(v, cam, lut).image, render(base, cam, lut).image, var.name,
+                                same_order);
         // World options are world options whatever the storage: a clip plane, a crop box, a
         // directional light with Phong shading, a spotlight with shadows (all in RAS mm).
         RenderOptions f;
@@ -321,12 +358,14 @@ TEST(Orientation, TheCh2HeadRendersTheSameInEveryStorage) {
     const Camera cam = orbit(bounds, 30, 15, Projection::Perspective, 80);
     const RenderResult want = render(base, cam, lut);
     const test::ScratchDir dir;
-    for (const Variant& var : {kVariants[1], kVariants[2], kVariants[4], kVariants[5], kVariants[6]}) {
+    for (const Variant& var :
+         {kVariants[1], kVariants[2], kVariants[4], kVariants[5], kVariants[6]}) {
         const Volume v = write_and_read(reorder(base, var.perm, var.flip), var, dir);
         SCOPED_TRACE(var.name);
         EXPECT_EQ(orientation_code(v), var.code);
         expect_same_world(v, base, var.name);
-        expect_same_picture(render(v, cam, lut).image, want.image, std::string("ch2 ") + var.name, false);
+        expect_same_picture(render(v, cam, lut).image, want.image, std::string("ch2 ") + var.name,
+                            false);
     }
 }
 
@@ -343,10 +382,10 @@ TransferLut marker_lut() {
     TransferFunction tf;
     tf.name = "markers";
     tf.domain = TfDomain::Value;
-    tf.color = {{0, 0.1f, 0.2f, 1.0f}, {130, 0.1f, 0.2f, 1.0f}, {130, 0.1f, 1.0f, 0.2f},
+    tf.color = {{0, 0.1f, 0.2f, 1.0f},   {130, 0.1f, 0.2f, 1.0f}, {130, 0.1f, 1.0f, 0.2f},
                 {190, 0.1f, 1.0f, 0.2f}, {190, 1.0f, 0.1f, 0.1f}, {255, 1.0f, 0.1f, 0.1f}};
-    tf.opacity = {{0, 0},    {97, 0},  {97, 1},  {103, 1}, {103, 0}, {157, 0},
-                  {157, 1},  {163, 1}, {163, 0}, {217, 0}, {217, 1}, {255, 1}};
+    tf.opacity = {{0, 0},   {97, 0},  {97, 1},  {103, 1}, {103, 0}, {157, 0},
+                  {157, 1}, {163, 1}, {163, 0}, {217, 0}, {217, 1}, {255, 1}};
     return discretise(tf, {0, 255});
 }
 
@@ -373,21 +412,25 @@ TEST(Orientation, NamedViewsPutTheAnatomyWhereRadiologistsExpectIt) {
     double x, y;
     // Anterior view (azimuth 0): the patient faces us, their right is on the screen's left,
     // superior is up.
-    const Image front = render(v, orbit(b, 0, 0, Projection::Orthographic, 96), lut, nullptr, mip()).image;
+    const Image front =
+        render(v, orbit(b, 0, 0, Projection::Orthographic, 96), lut, nullptr, mip()).image;
     ASSERT_TRUE(centroid(front, 0, x, y));  // right marker
     EXPECT_LT(x, 43);
     ASSERT_TRUE(centroid(front, 2, x, y));  // superior marker
     EXPECT_LT(y, 43);
     // Left view (azimuth 90): the face (anterior marker) is on the screen's left.
-    const Image left = render(v, orbit(b, 90, 0, Projection::Orthographic, 96), lut, nullptr, mip()).image;
+    const Image left =
+        render(v, orbit(b, 90, 0, Projection::Orthographic, 96), lut, nullptr, mip()).image;
     ASSERT_TRUE(centroid(left, 1, x, y));
     EXPECT_LT(x, 43);
     // Posterior view: the patient's right is on the screen's right.
-    const Image back = render(v, orbit(b, 180, 0, Projection::Orthographic, 96), lut, nullptr, mip()).image;
+    const Image back =
+        render(v, orbit(b, 180, 0, Projection::Orthographic, 96), lut, nullptr, mip()).image;
     ASSERT_TRUE(centroid(back, 0, x, y));
     EXPECT_GT(x, 53);
     // Superior view (looking down, anterior up): the face marker is at the top, right is right.
-    const Image top = render(v, orbit(b, 0, 90, Projection::Orthographic, 96), lut, nullptr, mip()).image;
+    const Image top =
+        render(v, orbit(b, 0, 90, Projection::Orthographic, 96), lut, nullptr, mip()).image;
     ASSERT_TRUE(centroid(top, 1, x, y));
     EXPECT_LT(y, 43);
     ASSERT_TRUE(centroid(top, 0, x, y));
@@ -406,7 +449,8 @@ Volume rotated(const Volume& base, double degrees) {
     Mat3 r{};
     for (int row = 0; row < 3; ++row)
         for (int col = 0; col < 3; ++col)
-            for (int k = 0; k < 3; ++k) r[row][col] += rz[row][k] * (ab.m[k][col] / base.spacing[col]);
+            for (int k = 0; k < 3; ++k)
+                r[row][col] += rz[row][k] * (ab.m[k][col] / base.spacing[col]);
     set_ras_direction(v, r);
     // Keep the centre: t = centre - R S ic.
     Vec3d t = centre;
@@ -440,7 +484,8 @@ TEST(Orientation, AThirtyDegreeObliqueSformTurnsThePictureByThirtyDegrees) {
         double turn = (t1 - t0) * 180 / M_PI;
         if (turn > 180) turn -= 360;
         if (turn < -180) turn += 360;
-        EXPECT_NEAR(turn, 30.0, 2.0) << "marker " << marker << " " << x0 << "," << y0 << " -> " << x1 << "," << y1;
+        EXPECT_NEAR(turn, 30.0, 2.0)
+            << "marker " << marker << " " << x0 << "," << y0 << " -> " << x1 << "," << y1;
         // The distance from the centre is kept (a rotation, not a scale).
         EXPECT_NEAR(std::hypot(x1 - cx, y1 - cy), std::hypot(x0 - cx, y0 - cy), 1.5);
     }
@@ -457,9 +502,12 @@ TEST(Orientation, EveryStructureAndKernelPathIsExactOnObliqueData) {
         v.spacing = {0.6 + rng.uniform(), 0.6 + rng.uniform(), 0.6 + rng.uniform()};
         // A random rotation (three angles), mirrored on odd trials, and a random origin.
         const double ax = 6.3 * rng.uniform(), ay = 6.3 * rng.uniform(), az = 6.3 * rng.uniform();
-        const Mat3 rx{{{1, 0, 0}, {0, std::cos(ax), -std::sin(ax)}, {0, std::sin(ax), std::cos(ax)}}};
-        const Mat3 ry{{{std::cos(ay), 0, std::sin(ay)}, {0, 1, 0}, {-std::sin(ay), 0, std::cos(ay)}}};
-        const Mat3 rz{{{std::cos(az), -std::sin(az), 0}, {std::sin(az), std::cos(az), 0}, {0, 0, 1}}};
+        const Mat3 rx{
+            {{1, 0, 0}, {0, std::cos(ax), -std::sin(ax)}, {0, std::sin(ax), std::cos(ax)}}};
+        const Mat3 ry{
+            {{std::cos(ay), 0, std::sin(ay)}, {0, 1, 0}, {-std::sin(ay), 0, std::cos(ay)}}};
+        const Mat3 rz{
+            {{std::cos(az), -std::sin(az), 0}, {std::sin(az), std::cos(az), 0}, {0, 0, 1}}};
         auto mul = [](const Mat3& p, const Mat3& q) {
             Mat3 o{};
             for (int i = 0; i < 3; ++i)
@@ -471,12 +519,14 @@ TEST(Orientation, EveryStructureAndKernelPathIsExactOnObliqueData) {
         if (trial % 2)
             for (int row = 0; row < 3; ++row) r[row][1] = -r[row][1];
         set_ras_direction(v, r);
-        set_ras_origin(v, {100 * rng.uniform() - 50, 100 * rng.uniform() - 50, 100 * rng.uniform() - 50});
+        set_ras_origin(
+            v, {100 * rng.uniform() - 50, 100 * rng.uniform() - 50, 100 * rng.uniform() - 50});
         ASSERT_NO_THROW(check_geometry(v, "oblique"));
         const TransferLut lut = trial < 2 ? phantom_lut() : test::random_lut(v.vis_range(), rng);
         const Box3f b = world_bounds(v);
-        const Camera cam = orbit(b, 360.f * rng.uniform(), -70.f + 140.f * rng.uniform(),
-                                 trial % 3 ? Projection::Perspective : Projection::Orthographic, 31);
+        const Camera cam =
+            orbit(b, 360.f * rng.uniform(), -70.f + 140.f * rng.uniform(),
+                  trial % 3 ? Projection::Perspective : Projection::Orthographic, 31);
         RenderOptions o;
         o.keep_float = true;
         o.count_samples = true;
