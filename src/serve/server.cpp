@@ -74,7 +74,12 @@ bool is_loopback_name(const std::string& h) {
 
 class WsSession;
 
-struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
+// Lifetime: the Server owns the Impl alone. Sessions and handlers point to it without owning
+// it (a handler that owned it would be stored in the io_context the Impl owns: a cycle that
+// kept every server, its sessions and their buffers alive forever). ~Server joins both threads,
+// then ~Impl destroys the io_context last, which destroys the handlers still queued and with
+// them the sessions they hold (Asio's documented shutdown order).
+struct Server::Impl {
     Impl(FrameRenderer& r, ServerOptions o) : renderer(r), options(std::move(o)) {}
 
     FrameRenderer& renderer;
@@ -120,8 +125,8 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 // thread.
 class WsSession : public std::enable_shared_from_this<WsSession> {
   public:
-    WsSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
-        : m_ws(std::move(socket)), m_server(std::move(server)) {}
+    WsSession(tcp::socket&& socket, Server::Impl* server)
+        : m_ws(std::move(socket)), m_server(server) {}
 
     template <class Body, class Allocator>
     void run(http::request<Body, http::basic_fields<Allocator>> req) {
@@ -241,7 +246,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     }
 
     websocket::stream<beast::tcp_stream> m_ws;
-    std::shared_ptr<Server::Impl> m_server;
+    Server::Impl* m_server;  // outlives the session (see Server::Impl)
     beast::flat_buffer m_buffer;
     std::deque<std::string> m_texts;
     std::optional<std::string> m_frame;
@@ -268,8 +273,8 @@ bool Server::Impl::evict_idlest() {
 // One HTTP connection: GET/HEAD of an embedded asset, or the upgrade to /ws.
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
   public:
-    HttpSession(tcp::socket&& socket, std::shared_ptr<Server::Impl> server)
-        : m_stream(std::move(socket)), m_server(std::move(server)) {}
+    HttpSession(tcp::socket&& socket, Server::Impl* server)
+        : m_stream(std::move(socket)), m_server(server) {}
 
     void run() { read(); }
 
@@ -372,7 +377,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
 
     beast::tcp_stream m_stream;
-    std::shared_ptr<Server::Impl> m_server;
+    Server::Impl* m_server;  // outlives the session (see Server::Impl)
     beast::flat_buffer m_buffer;
     std::optional<http::request_parser<http::string_body>> m_parser;
     std::shared_ptr<void> m_res;
@@ -380,7 +385,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
 void Server::Impl::accept() {
     acceptor.async_accept(net::make_strand(ioc),
-                          beast::bind_front_handler(&Impl::on_accept, shared_from_this()));
+                          beast::bind_front_handler(&Impl::on_accept, this));
 }
 
 void Server::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
@@ -393,13 +398,13 @@ void Server::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
         accept_backoff = std::clamp(accept_backoff * 2, std::chrono::milliseconds(10),
                                     std::chrono::milliseconds(1000));
         accept_timer.expires_after(accept_backoff);
-        accept_timer.async_wait([self = shared_from_this()](beast::error_code e) {
-            if (!e && !self->stopping) self->accept();
+        accept_timer.async_wait([this](beast::error_code e) {
+            if (!e && !stopping) accept();
         });
         return;
     }
     accept_backoff = 0ms;
-    if (!ec) std::make_shared<HttpSession>(std::move(socket), shared_from_this())->run();
+    if (!ec) std::make_shared<HttpSession>(std::move(socket), this)->run();
     accept();
 }
 
@@ -521,7 +526,7 @@ void Server::Impl::close_all() {
 }
 
 Server::Server(FrameRenderer& renderer, ServerOptions options)
-    : m(std::make_shared<Impl>(renderer, std::move(options))) {
+    : m(std::make_unique<Impl>(renderer, std::move(options))) {
     HelloInfo h;
     h.volume_name = m->options.volume_name;
     h.volume = &renderer.volume();
@@ -563,11 +568,11 @@ uint16_t Server::start() {
     m->accept();
     if (m->options.handle_signals) {
         m->signals.emplace(m->ioc, SIGINT, SIGTERM);
-        m->signals->async_wait([impl = m](const boost::system::error_code& e, int) {
+        m->signals->async_wait([impl = m.get()](const boost::system::error_code& e, int) {
             if (!e) impl->close_all();
         });
     }
-    m->render_thread = std::thread([impl = m] { impl->render_loop(); });
+    m->render_thread = std::thread([impl = m.get()] { impl->render_loop(); });
     return m->port;
 }
 
@@ -582,7 +587,7 @@ void Server::run() {
 }
 
 void Server::stop() {
-    net::post(m->ioc, [impl = m] { impl->close_all(); });
+    net::post(m->ioc, [impl = m.get()] { impl->close_all(); });
 }
 
 Server::Stats Server::stats() const {

@@ -63,7 +63,7 @@ class Server {
   public:
     // The renderer must outlive the server.
     Server(FrameRenderer& renderer, ServerOptions options);
-    ~Server();  // stops and joins
+    ~Server();  // stops and joins the render thread; run() must have returned
     Server(const Server&) = delete;
     Server& operator=(const Server&) = delete;
 
@@ -89,7 +89,7 @@ class Server {
     struct Impl;  // opaque: Beast stays out of this header
 
   private:
-    std::shared_ptr<Impl> m;
+    std::unique_ptr<Impl> m;  // owned alone: see server.cpp
 };
 
 }  // namespace lacuna::serve
