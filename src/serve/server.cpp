@@ -25,6 +25,7 @@
 #include <set>
 #include <thread>
 
+#include "core/cancel.h"
 #include "lacuna/error.h"
 #include "serve/assets.h"
 #include "serve/jpeg.h"
@@ -98,7 +99,7 @@ struct Server::Impl {
     std::chrono::milliseconds accept_backoff{0};
 
     std::atomic<uint64_t> accept_errors{0}, idle_closed{0}, evicted{0}, budget_reduced{0},
-        dropped{0};
+        dropped{0}, started{0}, cancelled{0};
 
     // The render thread and its latest-wins slots (guarded by slot_mutex).
     std::mutex slot_mutex;
@@ -107,6 +108,11 @@ struct Server::Impl {
     bool render_stop = false;
     std::thread render_thread;
     double last_full_ms = 0;  // render thread only: drives the preview's reduction
+    // The frame in progress: whose it is (guarded by slot_mutex) and its cancellation flag,
+    // which a newer request of that tab or the tab's closing sets (core/cancel.h: the renderers
+    // stop between two tiles).
+    const WsSession* rendering = nullptr;
+    std::atomic<bool> cancel_frame{false};
     // Render thread only: milliseconds per pixel-sample-step unit (w * h / step) of the last
     // frame of each cost_key, the render budget's estimate.
     std::map<std::string, double> ms_per_unit;
@@ -201,6 +207,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
                     std::lock_guard<std::mutex> lock(m_server->slot_mutex);
                     pending = std::move(req);  // latest wins: an unrendered request is dropped
                     pending_received = Clock::now();
+                    // ... and so is the frame of this tab being rendered.
+                    if (m_server->rendering == this) m_server->cancel_frame = true;
                 }
                 m_server->submit(shared_from_this());
             } catch (const Error& e) {
@@ -216,6 +224,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             std::lock_guard<std::mutex> lock(m_server->slot_mutex);
             if (pending) ++m_server->dropped;
             pending.reset();
+            if (m_server->rendering == this) m_server->cancel_frame = true;
         }
         if (m_server->sessions.erase(shared_from_this()) && m_server->options.log)
             std::printf("viewer: tab closed (%zu open)\n", m_server->sessions.size());
@@ -438,6 +447,9 @@ void Server::Impl::render_loop() {
             req = std::move(*s->pending);
             s->pending.reset();
             received = s->pending_received;
+            rendering = s.get();
+            cancel_frame = false;
+            ++started;
         }
         std::string message;
         try {
@@ -467,7 +479,10 @@ void Server::Impl::render_loop() {
                 }
             }
             const Clock::time_point start = Clock::now();
-            Frame f = renderer.render(req, w, h);
+            Frame f = [&] {
+                const CancelScope cancellable(cancel_frame);  // the frame only, not refine()
+                return renderer.render(req, w, h);
+            }();
             ms_per_unit[key] = f.stats.seconds * 1e3 * double(req.step) / (double(w) * double(h));
             if (!req.preview) last_full_ms = f.stats.seconds * 1e3;
             FrameInfo info;
@@ -504,6 +519,10 @@ void Server::Impl::render_loop() {
                 idle = ready.empty();
             }
             if (idle && !req.preview) renderer.refine();
+        } catch (const Cancelled&) {
+            // A newer request of this tab (it is queued again and rendered next) or its closing:
+            // the frame is not sent.
+            ++cancelled;
         } catch (const std::exception& e) {
             // lacuna::Error (e.g. a structure's options) or out of memory: report, keep serving.
             net::post(ioc,
@@ -511,6 +530,8 @@ void Server::Impl::render_loop() {
                           s->send_text(std::move(m));
                       });
         }
+        std::lock_guard<std::mutex> lock(slot_mutex);
+        rendering = nullptr;
     }
 }
 
@@ -597,6 +618,8 @@ Server::Stats Server::stats() const {
     s.evicted = m->evicted;
     s.budget_reduced = m->budget_reduced;
     s.dropped = m->dropped;
+    s.started = m->started;
+    s.cancelled = m->cancelled;
     return s;
 }
 

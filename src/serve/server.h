@@ -19,7 +19,8 @@
 //     at 1/2 .. 1/8 of its size per side (the frame header says "reduced"), so one 4096² request
 //     holds the render thread for about the budget, not 24 s, while other tabs wait. A closed
 //     tab's queued request is dropped and a newer request replaces a queued one (latest wins);
-//     a frame already rendering runs to its end (the renderers have no cancellation point);
+//     a newer request of the tab, or its closing, also cancels its frame in progress between
+//     two tiles (core/cancel.h; a structure's first build runs to its end);
 //   - a malformed or unrenderable message is answered with an "error" message naming the field;
 //     the connection and the server stay up.
 //
@@ -83,6 +84,8 @@ class Server {
         uint64_t evicted = 0;         // idle WebSockets closed to admit a new tab
         uint64_t budget_reduced = 0;  // frames rendered reduced by the render budget
         uint64_t dropped = 0;         // queued requests of closed tabs, not rendered
+        uint64_t started = 0;         // frames the render thread began
+        uint64_t cancelled = 0;       // frames cancelled while rendering (newer request, closed tab)
     };
     Stats stats() const;
 

@@ -166,3 +166,39 @@ TEST(ServerRobustness, RenderBudgetReducesFramesEstimatedOverIt) {
     EXPECT_EQ(second.header["height"], 192 / reduced);
     EXPECT_EQ(server.stats().budget_reduced, 1u);
 }
+
+// A frame in progress is cancelled (between tiles) by a newer request of its tab, which is then
+// rendered, and by its tab's closing; the server serves on. The big frame (2048², no skipping,
+// no early termination: about 10^9 samples) cannot end before the next message is read.
+TEST(ServerRobustness, ANewerRequestOrAClosedTabCancelsTheFrameInProgress) {
+    Running server(32, [](ServerOptions& o) { o.render_budget_ms = 0; });  // rendered whole
+    const auto wait_for = [&](auto done) {  // a guard against hanging, not a timing
+        for (int i = 0; i < 120000 && !done(server.stats()); ++i) std::this_thread::sleep_for(1ms);
+        return done(server.stats());
+    };
+    json big = render_request(1, small_tf());
+    big["width"] = 2048;
+    big["height"] = 2048;
+    big["accel"] = "none";
+    big["ert"] = false;
+    big["step"] = 0.1;
+    Client c(server.port);
+    c.read_text();
+    c.send(big.dump());
+    ASSERT_TRUE(wait_for([](const Server::Stats& s) { return s.started == 1; }));
+    c.send(render_request(2, small_tf()).dump());
+    EXPECT_EQ(read_frame(c).header["id"], 2);  // frame 1 was never sent
+    EXPECT_EQ(server.stats().cancelled, 1u);
+    EXPECT_EQ(server.stats().started, 2u);
+    {
+        Client d(server.port);
+        d.read_text();
+        big["id"] = 3;
+        d.send(big.dump());
+        ASSERT_TRUE(wait_for([](const Server::Stats& s) { return s.started == 3; }));
+    }  // the tab closes
+    EXPECT_TRUE(wait_for([](const Server::Stats& s) { return s.cancelled == 2; }));
+    c.send(render_request(4, small_tf()).dump());
+    EXPECT_EQ(read_frame(c).header["id"], 4);
+    EXPECT_EQ(server.stats().cancelled, 2u);
+}
