@@ -34,12 +34,15 @@ Equal work, case by case (each point is checked against lacuna's sources):
   background black for both (lacuna's default; VTK's renderer default).
   threads    2 for both: lacuna --threads 2; VTK mapper SetNumberOfThreads(2) and the global
              vtkMultiThreader / vtkSMPTools limits.
-Timing: per round and case, lacuna renders --frames frames, each one `lacuna render` process
-(its printed render time: the structure build and the file read are outside it); VTK renders one
-warm-up frame (gradients, shading tables, space-leaping volume) and then --frames timed
-Render() calls of the same view, wall time (perf_counter) and process CPU time (process_time,
-all of VTK's threads). A round's value is the median of its frames, the reported value the median
-of the rounds; the order lacuna/VTK alternates from round to round.
+Timing: per round and case, each side renders one warm-up frame and then --frames timed frames
+of the same view, in one process: lacuna one `lacuna render --repeat (frames + 1)` process (it
+prints the median of frames 2..N as its "render time", and that median's CPU time; the file
+read, the structure build and its refinement are outside it), VTK one warm-up Render() (gradients,
+shading tables, space-leaping volume) and then --frames timed Render() calls, wall time
+(perf_counter) and process CPU time (process_time, all of VTK's threads). A round's value is the
+median of its frames, the reported value the median of the rounds; the order lacuna/VTK
+alternates from round to round. (Until 2026-12-02 lacuna's frames were each a fresh process, a
+cold first frame against VTK's warm ones: 10-25% slower at 512².)
 """
 import argparse
 import csv
@@ -140,7 +143,9 @@ def write_lacuna_tf(path, tf):
 
 
 def lacuna_render(a, volume, tf_json, size, shading, out_png):
+    """One warm-up and a.frames timed frames; (median ms, its CPU ms, samples/ray, accel)."""
     cmd = [a.lacuna, "render", volume, "--tf", tf_json, "--size", str(size),
+           "--repeat", str(a.frames + 1),
            "--step", repr(a.step), "--ert", repr(VTK_ERT), "--threads", str(a.threads),
            "--azimuth", repr(a.azimuth), "--elevation", repr(a.elevation), "--out", out_png]
     if shading == "phong":
@@ -155,6 +160,7 @@ def lacuna_render(a, volume, tf_json, size, shading, out_png):
     if r.returncode != 0:
         raise BadInput("lacuna render failed (%d): %s" % (r.returncode, r.stderr.strip()))
     m = re.search(r"render time ([0-9.]+) ms, ([0-9.]+) samples/ray", r.stdout)
+    cpu = re.search(r"render time .*, CPU ([0-9.]+) ms", r.stdout)
     asked = re.search(r", accel ([^,]+), \d+ threads", r.stdout)
     built = re.search(r"^accel (\S+): build", r.stdout, re.M)  # the structure actually built
     if not m:
@@ -162,7 +168,7 @@ def lacuna_render(a, volume, tf_json, size, shading, out_png):
     accel = asked.group(1) if asked else "?"
     if built and built.group(1) != accel:
         accel += " → " + built.group(1)
-    return float(m.group(1)), float(m.group(2)), accel
+    return float(m.group(1)), float(cpu.group(1)) if cpu else 0.0, float(m.group(2)), accel
 
 
 # ---- VTK side ----------------------------------------------------------------------------------
@@ -470,7 +476,7 @@ def run(a, tmp):
     scene = VtkScene(a.threads)
     images = {}
     jobs = [(c, s, sh) for c in a.cases for s in a.sizes for sh in a.shading]
-    res = {j: {"vtk": [], "vtk_cpu": [], "lac": [], "spr": 0.0, "accel": "?"} for j in jobs}
+    res = {j: {"vtk": [], "vtk_cpu": [], "lac": [], "lac_cpu": [], "spr": 0.0, "accel": "?"} for j in jobs}
     for rnd in range(a.rounds):
         for j in jobs:
             c, size, sh = j
@@ -482,11 +488,9 @@ def run(a, tmp):
             lac_png = os.path.join(a.out_dir, stem + "_lacuna.png")
 
             def do_lacuna():
-                ms = []
-                for _ in range(a.frames):
-                    t, spr, acc = lacuna_render(a, paths[name], tfs[tf], size, sh, lac_png)
-                    ms.append(t)
-                res[j]["lac"].append(statistics.median(ms))
+                t, cpu, spr, acc = lacuna_render(a, paths[name], tfs[tf], size, sh, lac_png)
+                res[j]["lac"].append(t)
+                res[j]["lac_cpu"].append(cpu)
                 res[j]["spr"], res[j]["accel"] = spr, acc
 
             def do_vtk():
@@ -519,10 +523,12 @@ def run(a, tmp):
         r = res[j]
         vtk_ms, lac_ms = statistics.median(r["vtk"]), statistics.median(r["lac"])
         vtk_cpu = statistics.median(r["vtk_cpu"])
+        lac_cpu = statistics.median(r["lac_cpu"])
         mad, mad_obj, dmax, cover = r["diff"]
         rows.append({"case": c, "size": size, "shading": sh, "vtk_ms": vtk_ms,
                      "lacuna_ms": lac_ms, "ratio": vtk_ms / lac_ms if lac_ms > 0 else 0.0,
                      "vtk_cpu_ms": vtk_cpu, "vtk_cpu_per_wall": vtk_cpu / vtk_ms if vtk_ms else 0,
+                     "lacuna_cpu_ms": lac_cpu, "cpu_ratio": vtk_cpu / lac_cpu if lac_cpu > 0 else 0.0,
                      "lacuna_accel": r["accel"], "lacuna_samples_per_ray": r["spr"],
                      "mad": mad, "mad_object": mad_obj, "max_diff": dmax, "coverage": cover,
                      "mad_window": r["diff_window"], "vtk_image_compared": r["compared"],
@@ -553,20 +559,20 @@ def markdown(rows, info, a):
     out.append("Machine: %s; VTK %s; lacuna %s; %s, %.0f min, load %s -> %s.\n\n"
                % (info["machine"], info["vtk"], info["commit"], info["date"], info["minutes"],
                   info["load_start"], info["load_end"]))
-    out.append("%d rounds, each: %d lacuna frames (one `lacuna render` each) and 1 warm-up + %d "
-               "timed VTK frames of the same view (azimuth %g, elevation %g); medians. "
+    out.append("%d rounds, each: 1 warm-up + %d timed frames of the same view per side (lacuna: "
+               "one `lacuna render --repeat` process; VTK: Render() calls), azimuth %g, elevation %g; medians. "
                "%d threads, step %g x min spacing, ERT %g.\n\n"
-               % (a.rounds, a.frames, a.frames, a.azimuth, a.elevation, a.threads, a.step, VTK_ERT))
+               % (a.rounds, a.frames, a.azimuth, a.elevation, a.threads, a.step, VTK_ERT))
     out.append("| case | size | shading | VTK [ms] | lacuna [ms] | VTK / lacuna | VTK CPU [ms] "
-               "| VTK CPU/wall | lacuna accel | lacuna samples/ray | MAD | MAD (object) "
+               "| lacuna CPU [ms] | CPU ratio | VTK CPU/wall | lacuna accel | lacuna samples/ray | MAD | MAD (object) "
                "| max diff | MAD (VTK window) |\n")
-    out.append("|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n")
+    out.append("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n")
     for r in rows:
         flag = "" if r["equal_work"] else " **≥ 2**"
-        out.append("| %s | %d² | %s | %.1f | %.1f | %.2f× | %.1f | %.2f | %s | %.1f | %.2f%s "
-                   "| %.2f | %d | %.2f |\n"
+        out.append("| %s | %d² | %s | %.1f | %.1f | %.2f× | %.1f | %.1f | %.2f× | %.2f | %s | %.1f "
+                   "| %.2f%s | %.2f | %d | %.2f |\n"
                    % (r["case"], r["size"], r["shading"], r["vtk_ms"], r["lacuna_ms"], r["ratio"],
-                      r["vtk_cpu_ms"], r["vtk_cpu_per_wall"], r["lacuna_accel"],
+                      r["vtk_cpu_ms"], r["lacuna_cpu_ms"], r["cpu_ratio"], r["vtk_cpu_per_wall"], r["lacuna_accel"],
                       r["lacuna_samples_per_ray"], r["mad"], flag, r["mad_object"],
                       r["max_diff"], r["mad_window"]))
     compared = sorted({r["vtk_image_compared"] for r in rows})
