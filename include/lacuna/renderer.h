@@ -46,7 +46,7 @@ struct PbrParams {
 };
 
 enum class GradientSource {
-    OnTheFly,     // central differences of trilinear samples at +-1 voxel around the sample
+    OnTheFly,     // the voxels' central differences, interpolated at the sample (core/gradient.h)
     Precomputed,  // central differences per voxel stored as 3 floats, interpolated trilinearly
 };
 

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "core/gradient.h"
 #include "core/simd_lanes.h"
 #include "core/spec_pow.h"
 
@@ -45,6 +46,17 @@ struct ShadeRay {
     float o[3], d[3];
     float t_base, dt;
 };
+
+// central_gradient (core/gradient.h) at the first n positions, one after the other.
+template <class T>
+inline void central_gradients(const ShadeGrid& g, const T* data, const float* px, const float* py,
+                              const float* pz, float* gx, float* gy, float* gz, int n) {
+    for (int l = 0; l < n; ++l) {
+        float r[3];
+        central_gradient(data, g.sy, g.sz, g.hi, g.cell, g.inv_sp, px[l], py[l], pz[l], r);
+        gx[l] = r[0], gy[l] = r[1], gz[l] = r[2];
+    }
+}
 
 #if LACUNA_SIMD_X86 && defined(__SSE4_1__)
 
@@ -126,22 +138,11 @@ inline int samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const 
     return _mm_movemask_ps(_mm_cmpgt_ps(a, zero));
 }
 
-// Central differences of trilinear samples one voxel to either side, in values per mm
-// (feature::gradient's on-the-fly branch), for 4 positions.
+// feature::gradient's on-the-fly branch (core/gradient.h), for 4 positions: lane by lane.
 template <class T>
 inline void gradients4(const ShadeGrid& g, const T* data, const float* px, const float* py,
                        const float* pz, float* gx, float* gy, float* gz) {
-    const __m128 one = _mm_set1_ps(1.f), half = _mm_set1_ps(0.5f);
-    const __m128 x = _mm_loadu_ps(px), y = _mm_loadu_ps(py), z = _mm_loadu_ps(pz);
-    const __m128 dx = _mm_sub_ps(trilinear4(g, data, _mm_add_ps(x, one), y, z),
-                                 trilinear4(g, data, _mm_sub_ps(x, one), y, z));
-    const __m128 dy = _mm_sub_ps(trilinear4(g, data, x, _mm_add_ps(y, one), z),
-                                 trilinear4(g, data, x, _mm_sub_ps(y, one), z));
-    const __m128 dz = _mm_sub_ps(trilinear4(g, data, x, y, _mm_add_ps(z, one)),
-                                 trilinear4(g, data, x, y, _mm_sub_ps(z, one)));
-    _mm_storeu_ps(gx, _mm_mul_ps(_mm_mul_ps(dx, half), _mm_set1_ps(g.inv_sp[0])));
-    _mm_storeu_ps(gy, _mm_mul_ps(_mm_mul_ps(dy, half), _mm_set1_ps(g.inv_sp[1])));
-    _mm_storeu_ps(gz, _mm_mul_ps(_mm_mul_ps(dz, half), _mm_set1_ps(g.inv_sp[2])));
+    central_gradients(g, data, px, py, pz, gx, gy, gz, 4);
 }
 
 // The precomputed gradient volume's three trilinear lookups (feature::gradient's first branch),
@@ -205,21 +206,123 @@ LACUNA_AVX2 int samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, c
     return _mm256_movemask_ps(_mm256_cmp_ps(a, zero, _CMP_GT_OQ));
 }
 
-// gradients4's eight-lane twin.
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256i load8(const uint32_t* a) {
+    return _mm256_load_si256(reinterpret_cast<const __m256i*>(a));
+}
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256i load8(const uint16_t* a) {
+    return _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(a)));
+}
+// a + t * (b - a), trilinear()'s lerp.
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 lerp8(__m256 a, __m256 b, __m256 t) {
+    return _mm256_add_ps(a, _mm256_mul_ps(t, _mm256_sub_ps(b, a)));
+}
+
+// Field f (0-based) of each 32-bit lane, holding voxels of type T packed from low to high.
+template <class T>
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 voxel_field8(__m256i w, int f) {
+    if constexpr (sizeof(T) == 1)
+        return _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 8 * f), _mm256_set1_epi32(0xff)));
+    else if constexpr (std::is_signed_v<T>)
+        return _mm256_cvtepi32_ps(f == 0 ? _mm256_srai_epi32(_mm256_slli_epi32(w, 16), 16)
+                                         : _mm256_srai_epi32(w, 16));
+    else
+        return _mm256_cvtepi32_ps(f == 0 ? _mm256_and_si256(w, _mm256_set1_epi32(0xffff))
+                                         : _mm256_srli_epi32(w, 16));
+}
+
+// gradients4's eight-lane twin: central_gradient's operations per lane. Integer voxels away
+// from the grid's faces read their 32 voxels as packed rows (per corner row of the cell, the four
+// voxels i-1..i+2 along x; two voxels past each y and z face of the cell); a batch with a lane
+// on a face, and float voxels, go through central_gradient lane by lane.
 template <class T>
 LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, const float* py,
                             const float* pz, float* gx, float* gy, float* gz) {
-    const __m256 one = _mm256_set1_ps(1.f), half = _mm256_set1_ps(0.5f);
-    const __m256 x = _mm256_loadu_ps(px), y = _mm256_loadu_ps(py), z = _mm256_loadu_ps(pz);
-    const __m256 dx = _mm256_sub_ps(trilinear8(g, data, _mm256_add_ps(x, one), y, z),
-                                    trilinear8(g, data, _mm256_sub_ps(x, one), y, z));
-    const __m256 dy = _mm256_sub_ps(trilinear8(g, data, x, _mm256_add_ps(y, one), z),
-                                    trilinear8(g, data, x, _mm256_sub_ps(y, one), z));
-    const __m256 dz = _mm256_sub_ps(trilinear8(g, data, x, y, _mm256_add_ps(z, one)),
-                                    trilinear8(g, data, x, y, _mm256_sub_ps(z, one)));
-    _mm256_storeu_ps(gx, _mm256_mul_ps(_mm256_mul_ps(dx, half), _mm256_set1_ps(g.inv_sp[0])));
-    _mm256_storeu_ps(gy, _mm256_mul_ps(_mm256_mul_ps(dy, half), _mm256_set1_ps(g.inv_sp[1])));
-    _mm256_storeu_ps(gz, _mm256_mul_ps(_mm256_mul_ps(dz, half), _mm256_set1_ps(g.inv_sp[2])));
+    if constexpr (sizeof(T) > 2) {
+        central_gradients(g, data, px, py, pz, gx, gy, gz, 8);
+    } else {
+        const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
+        __m256 p[3] = {_mm256_loadu_ps(px), _mm256_loadu_ps(py), _mm256_loadu_ps(pz)}, f[3];
+        __m256i c[3], inside = _mm256_set1_epi32(-1);
+        for (int a = 0; a < 3; ++a) {
+            p[a] = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[a]), p[a]));
+            c[a] = _mm256_min_epi32(_mm256_cvttps_epi32(p[a]), _mm256_set1_epi32(g.cell[a]));
+            f[a] = _mm256_sub_ps(p[a], _mm256_cvtepi32_ps(c[a]));
+            // 1 <= c <= cell - 1: the rows c-1 .. c+2 are inside the grid.
+            inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(c[a], _mm256_setzero_si256()));
+            inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(_mm256_set1_epi32(g.cell[a]), c[a]));
+        }
+        // Lanes on a face: central_gradient at the end; their rows are read at cell (1, 1, 1).
+        const int faces = ~_mm256_movemask_ps(_mm256_castsi256_ps(inside)) & 0xff;
+        if (faces == 0xff) {
+            central_gradients(g, data, px, py, pz, gx, gy, gz, 8);
+            return;
+        }
+        for (int a = 0; a < 3; ++a) c[a] = _mm256_blendv_epi8(_mm256_set1_epi32(1), c[a], inside);
+        alignas(32) int32_t o[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(o),
+                           _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(c[2], _mm256_set1_epi32(g.sz)),
+                                                             _mm256_mullo_epi32(c[1], _mm256_set1_epi32(g.sy))),
+                                            c[0]));
+        // Per lane: rows[r] = v(i-1 .. i+2) at (j + (r & 1), k + (r >> 1)) (16-bit voxels: the
+        // low pair i-1, i in rows[r], the high pair i+1, i+2 in rows[4 + r]); the pairs v(i, i+1)
+        // at y = j-1 (ym), j+2 (yp) for z = k, k+1 and at z = k-1 (zm), k+2 (zp) for y = j, j+1.
+        constexpr bool kByte = sizeof(T) == 1;
+        // Pairs: two voxels, 16-bit (byte voxels; widened after loading) or 32-bit.
+        using Pair = std::conditional_t<kByte, uint16_t, uint32_t>;
+        alignas(32) uint32_t rows[8][8];
+        alignas(32) Pair ym[2][8], yp[2][8], zm[2][8], zp[2][8];
+        const ptrdiff_t sy = g.sy, sz = g.sz;
+        const ptrdiff_t row_at[4] = {0, sy, sz, sy + sz};
+        for (int l = 0; l < 8; ++l) {
+            const T* q = data + o[l];
+            for (int r = 0; r < 4; ++r) {
+                __builtin_memcpy(&rows[r][l], q + row_at[r] - 1, 4);
+                if constexpr (!kByte) __builtin_memcpy(&rows[4 + r][l], q + row_at[r] + 1, 4);
+            }
+            __builtin_memcpy(&ym[0][l], q - sy, sizeof(Pair));
+            __builtin_memcpy(&ym[1][l], q - sy + sz, sizeof(Pair));
+            __builtin_memcpy(&yp[0][l], q + 2 * sy, sizeof(Pair));
+            __builtin_memcpy(&yp[1][l], q + 2 * sy + sz, sizeof(Pair));
+            __builtin_memcpy(&zm[0][l], q - sz, sizeof(Pair));
+            __builtin_memcpy(&zm[1][l], q - sz + sy, sizeof(Pair));
+            __builtin_memcpy(&zp[0][l], q + 2 * sz, sizeof(Pair));
+            __builtin_memcpy(&zp[1][l], q + 2 * sz + sy, sizeof(Pair));
+        }
+        // R[r][m] = v(i - 1 + m) of row r, as floats.
+        __m256 R[4][4];
+        for (int r = 0; r < 4; ++r) {
+            if constexpr (kByte) {
+                const __m256i w = load8(rows[r]);
+                for (int m = 0; m < 4; ++m) R[r][m] = voxel_field8<T>(w, m);
+            } else {
+                const __m256i lo = load8(rows[r]), hi = load8(rows[4 + r]);
+                R[r][0] = voxel_field8<T>(lo, 0), R[r][1] = voxel_field8<T>(lo, 1);
+                R[r][2] = voxel_field8<T>(hi, 0), R[r][3] = voxel_field8<T>(hi, 1);
+            }
+        }
+        __m256 d[3][8];
+        for (int q = 0; q < 8; ++q) {
+            const int a = q & 1, b = q >> 1 & 1, cz = q >> 2;
+            d[0][q] = _mm256_sub_ps(R[b + 2 * cz][a + 2], R[b + 2 * cz][a]);
+            d[1][q] = b == 0 ? _mm256_sub_ps(R[1 + 2 * cz][a + 1], voxel_field8<T>(load8(ym[cz]), a))
+                             : _mm256_sub_ps(voxel_field8<T>(load8(yp[cz]), a), R[2 * cz][a + 1]);
+            d[2][q] = cz == 0 ? _mm256_sub_ps(R[b + 2][a + 1], voxel_field8<T>(load8(zm[b]), a))
+                              : _mm256_sub_ps(voxel_field8<T>(load8(zp[b]), a), R[b][a + 1]);
+        }
+        float* out[3] = {gx, gy, gz};
+        for (int e = 0; e < 3; ++e) {
+            const __m256* v = d[e];
+            const __m256 c00 = lerp8(v[0], v[1], f[0]), c10 = lerp8(v[2], v[3], f[0]);
+            const __m256 c01 = lerp8(v[4], v[5], f[0]), c11 = lerp8(v[6], v[7], f[0]);
+            const __m256 c0 = lerp8(c00, c10, f[1]), c1 = lerp8(c01, c11, f[1]);
+            _mm256_storeu_ps(out[e], _mm256_mul_ps(_mm256_mul_ps(lerp8(c0, c1, f[2]), half),
+                                                   _mm256_set1_ps(g.inv_sp[e])));
+        }
+        for (int m = faces; m; m &= m - 1) {
+            const int l = __builtin_ctz(unsigned(m));
+            central_gradients(g, data, px + l, py + l, pz + l, gx + l, gy + l, gz + l, 1);
+        }
+    }
 }
 
 // The precomputed gradient volume's three trilinear lookups (feature::gradient's first branch),

@@ -35,6 +35,7 @@
 #include "lacuna/camera.h"
 #include "lacuna/image.h"
 #include "lacuna/renderer.h"
+#include "core/gradient.h"
 #include "core/simd_shading.h"
 #include "render/ray_march_kernel.h"
 #include "render/shading.h"
@@ -127,11 +128,12 @@ inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x
                 kernel::trilinear(float_grid(c.grad[1], m), x, y, z),
                 kernel::trilinear(float_grid(c.grad[2], m), x, y, z)};
     }
-    // Central differences of trilinear samples one voxel to either side (clamped at the box).
-    const float gx = (kernel::trilinear(g, x + 1.f, y, z) - kernel::trilinear(g, x - 1.f, y, z)) * 0.5f;
-    const float gy = (kernel::trilinear(g, x, y + 1.f, z) - kernel::trilinear(g, x, y - 1.f, z)) * 0.5f;
-    const float gz = (kernel::trilinear(g, x, y, z + 1.f) - kernel::trilinear(g, x, y, z - 1.f)) * 0.5f;
-    return {gx * c.inv_sp.x, gy * c.inv_sp.y, gz * c.inv_sp.z};
+    // The voxels' central differences, interpolated at the sample (core/gradient.h).
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z}, isp[3] = {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z};
+    const int cell[3] = {g.cell_x, g.cell_y, g.cell_z};
+    float gr[3];
+    central_gradient(g.data, g.sy, g.sz, hi, cell, isp, x, y, z, gr);
+    return {gr[0], gr[1], gr[2]};
 }
 
 // Transmittance from index point (x,y,z) toward the light along world direction l (unit), up to

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "accel/no_accel.h"
+#include "core/gradient.h"
 #include "core/spec_pow.h"
 #include "common/rng.h"
 #include "conformance/conformance_util.h"
@@ -74,6 +75,72 @@ TEST(Shading, OnTheFlyAndPrecomputedGradientsFollowTheBallsNormal) {
         const Vec3f expected = normalize(Vec3f{u.x / float(sp.x), u.y / float(sp.y), u.z / float(sp.z)});
         EXPECT_GT(dot(n, expected), std::cos(3.f * shading::kPi / 180.f)) << "point " << i;
     }
+}
+
+// core/gradient.h's argument, checked: the interpolated central differences of the voxels are
+// the central differences (f(p + e) - f(p - e)) / 2 of the trilinear field f, in double
+// precision here, wherever p +- 1 stays inside the grid; at a face, the border voxel repeated.
+TEST(Shading, OnTheFlyGradientIsTheCentralDifferenceOfTheTrilinearField) {
+    test::Rng rng{77};
+    const int dims[3] = {9, 7, 8};
+    Volume v({dims[0], dims[1], dims[2]}, VoxelType::Int16);
+    for (int z = 0; z < dims[2]; ++z)
+        for (int y = 0; y < dims[1]; ++y)
+            for (int x = 0; x < dims[0]; ++x) v.set_value(x, y, z, float(rng.range(-3000, 3000)));
+    v.compute_range();
+    const int16_t* d = v.data_as<int16_t>();
+    const ptrdiff_t sy = dims[0], sz = ptrdiff_t(dims[0]) * dims[1];
+    const float hi[3] = {8, 6, 7}, inv_sp[3] = {1.f, 0.5f, 2.f};
+    const int cell[3] = {7, 5, 6};
+    auto vox = [&](int x, int y, int z) {
+        x = std::clamp(x, 0, dims[0] - 1), y = std::clamp(y, 0, dims[1] - 1), z = std::clamp(z, 0, dims[2] - 1);
+        return double(d[z * sz + y * sy + x]);
+    };
+    auto field = [&](double x, double y, double z) {  // trilinear, double precision
+        const int i = std::min(int(x), cell[0]), j = std::min(int(y), cell[1]), k = std::min(int(z), cell[2]);
+        const double fx = x - i, fy = y - j, fz = z - k;
+        double s = 0;
+        for (int q = 0; q < 8; ++q) {
+            const int a = q & 1, b = q >> 1 & 1, c = q >> 2;
+            s += (a ? fx : 1 - fx) * (b ? fy : 1 - fy) * (c ? fz : 1 - fz) * vox(i + a, j + b, k + c);
+        }
+        return s;
+    };
+    int interior = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        const double p[3] = {rng.uniform() * hi[0], rng.uniform() * hi[1], rng.uniform() * hi[2]};
+        float g[3];
+        central_gradient(d, sy, sz, hi, cell, inv_sp, float(p[0]), float(p[1]), float(p[2]), g);
+        const double q[3] = {double(float(p[0])), double(float(p[1])), double(float(p[2]))};
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) inside = inside && q[a] >= 1.0 && q[a] <= hi[a] - 1.0;
+        for (int a = 0; a < 3; ++a) {
+            double lo[3] = {q[0], q[1], q[2]}, up[3] = {q[0], q[1], q[2]};
+            if (inside) {
+                lo[a] -= 1, up[a] += 1;
+                const double want = (field(up[0], up[1], up[2]) - field(lo[0], lo[1], lo[2])) * 0.5 * inv_sp[a];
+                ASSERT_NEAR(g[a], want, 2e-3 * (1 + std::abs(want))) << "axis " << a << " trial " << trial;
+            } else {
+                // The border voxel repeated: interpolate v[i+1] - v[i-1] with clamped indices.
+                const int i = std::min(int(q[0]), cell[0]), j = std::min(int(q[1]), cell[1]),
+                          k = std::min(int(q[2]), cell[2]);
+                const double f[3] = {q[0] - i, q[1] - j, q[2] - k};
+                double s = 0;
+                for (int c8 = 0; c8 < 8; ++c8) {
+                    int o[3] = {i + (c8 & 1), j + (c8 >> 1 & 1), k + (c8 >> 2)};
+                    double w = 1;
+                    for (int e = 0; e < 3; ++e) w *= (c8 >> e & 1) ? f[e] : 1 - f[e];
+                    int u[3] = {o[0], o[1], o[2]}, m[3] = {o[0], o[1], o[2]};
+                    ++u[a], --m[a];
+                    s += w * (vox(u[0], u[1], u[2]) - vox(m[0], m[1], m[2]));
+                }
+                ASSERT_NEAR(g[a], s * 0.5 * inv_sp[a], 2e-3 * (1 + std::abs(s))) << "face, axis " << a;
+            }
+        }
+        interior += inside;
+    }
+    EXPECT_GT(interior, 200);
+    EXPECT_LT(interior, 3800);
 }
 
 TEST(Shading, LambertTermOfAShadedBallMatchesTheAnalyticNormal) {
