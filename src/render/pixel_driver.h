@@ -58,17 +58,20 @@ inline int lattice_end(float t_base, float t_far, float dt) {
 
 // The runs [kb, ke) of lattice samples t_k = t_base + (k + 0.5)*dt, k < k_end, that lie in the
 // cursor's segments, rounded outward (a few extra reference samples may be taken, a visible one
-// is never missed), in order and disjoint: a pull source, one run per next().
+// is never missed), in order and disjoint: a pull source, one run per next(). The rounding keeps
+// a whole sample of margin on either side (floor(u - 0.5) and floor(u - 0.5) + 2 for the exact
+// u = (t - t_base) / dt), so u may be off by ulps: it is (t - t_base) * (1 / dt), a multiply
+// where a division sat on the scheduler's critical path.
 template <class Cursor>
 class LatticeRuns {
 public:
     LatticeRuns(Cursor& cursor, float t_base, float dt, int k_end)
-        : m_cursor(cursor), m_t_base(t_base), m_dt(dt), m_end(k_end) {}
+        : m_cursor(cursor), m_t_base(t_base), m_inv_dt(1.f / dt), m_end(k_end) {}
     bool next(int& kb, int& ke) {
         Segment seg;
         while (m_k < m_end && m_cursor.next(seg)) {
-            const int b = std::max(m_k, int(std::floor((seg.t0 - m_t_base) / m_dt - 0.5f)));
-            const int e = std::min(m_end, int(std::floor((seg.t1 - m_t_base) / m_dt - 0.5f)) + 2);
+            const int b = std::max(m_k, int(std::floor((seg.t0 - m_t_base) * m_inv_dt - 0.5f)));
+            const int e = std::min(m_end, int(std::floor((seg.t1 - m_t_base) * m_inv_dt - 0.5f)) + 2);
             m_k = std::max(m_k, e);
             if (e > b) {
                 kb = b;
@@ -81,7 +84,7 @@ public:
 
 private:
     Cursor& m_cursor;
-    float m_t_base, m_dt;
+    float m_t_base, m_inv_dt;
     int m_end, m_k = 0;
 };
 
