@@ -514,6 +514,109 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define LACUNA_AVX512 __attribute__((target("avx512f")))
 
+// Trilinear values at sixteen index-space points already clamped into [0, hi] (trilinear8's
+// operations in its order); lanes outside `live` read voxel 0's cell, their values unused. G has
+// cell[3], sy, sz.
+template <class T, class G>
+LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& g, const T* data,
+                                                                      __m512 x, __m512 y, __m512 z,
+                                                                      __mmask16 live) {
+    constexpr bool kByte = sizeof(T) == 1;
+    const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), _mm512_set1_epi32(g.cell[0]));
+    const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), _mm512_set1_epi32(g.cell[1]));
+    const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(z), _mm512_set1_epi32(g.cell[2]));
+    const __m512 fx = _mm512_sub_ps(x, _mm512_cvtepi32_ps(ci));
+    const __m512 fy = _mm512_sub_ps(y, _mm512_cvtepi32_ps(cj));
+    const __m512 fz = _mm512_sub_ps(z, _mm512_cvtepi32_ps(ck));
+    __m512i off = _mm512_add_epi32(
+        _mm512_add_epi32(_mm512_mullo_epi32(ck, _mm512_set1_epi32(g.sz)), _mm512_mullo_epi32(cj, _mm512_set1_epi32(g.sy))), ci);
+    off = _mm512_maskz_mov_epi32(live, off);  // other lanes read voxel 0
+    __m512 c000, c100, c010, c110, c001, c101, c011, c111;
+    if constexpr (kByte) {
+        // Corner pairs by 16-bit scalar loads into a table (trilinear8's way; cheaper than
+        // four sixteen-lane gathers here), widened: low byte voxel i, high byte voxel i + 1.
+        alignas(64) int32_t ofs[16];
+        alignas(32) uint16_t wp[4][16];
+        _mm512_store_si512(ofs, off);
+        const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
+        for (int l = 0; l < 16; ++l) {
+            const T* p = data + ofs[l];
+            __builtin_memcpy(&wp[0][l], p, 2);
+            __builtin_memcpy(&wp[1][l], p + psy, 2);
+            __builtin_memcpy(&wp[2][l], p + psz, 2);
+            __builtin_memcpy(&wp[3][l], p + psyz, 2);
+        }
+        const __m512i m = _mm512_set1_epi32(0xff);
+        const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
+        const __m512i w1 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
+        const __m512i w2 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[2])));
+        const __m512i w3 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[3])));
+        c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
+        c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 8));
+        c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
+        c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 8));
+        c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
+        c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 8));
+        c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
+        c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 8));
+    } else if constexpr (sizeof(T) == 2) {
+        // 16-bit voxels: each corner pair is one 32-bit scalar load, into a table.
+        alignas(64) int32_t ofs[16];
+        alignas(64) int32_t wq[4][16];
+        _mm512_store_si512(ofs, off);
+        const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
+        for (int l = 0; l < 16; ++l) {
+            const T* p = data + ofs[l];
+            __builtin_memcpy(&wq[0][l], p, 4);
+            __builtin_memcpy(&wq[1][l], p + psy, 4);
+            __builtin_memcpy(&wq[2][l], p + psz, 4);
+            __builtin_memcpy(&wq[3][l], p + psyz, 4);
+        }
+        const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
+        const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
+        if constexpr (std::is_signed_v<T>) {
+            c000 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w0, 16), 16));
+            c010 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w1, 16), 16));
+            c001 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w2, 16), 16));
+            c011 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w3, 16), 16));
+            c100 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w0, 16));
+            c110 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w1, 16));
+            c101 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w2, 16));
+            c111 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w3, 16));
+        } else {
+            const __m512i m = _mm512_set1_epi32(0xffff);
+            c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
+            c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
+            c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
+            c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
+            c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 16));
+            c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 16));
+            c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 16));
+            c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 16));
+        }
+    } else {
+        const float* base = reinterpret_cast<const float*>(data);
+        const __m512i o1 = _mm512_add_epi32(off, _mm512_set1_epi32(g.sy)),
+                      o2 = _mm512_add_epi32(off, _mm512_set1_epi32(g.sz)),
+                      o3 = _mm512_add_epi32(off, _mm512_set1_epi32(g.sy + g.sz));
+        c000 = _mm512_i32gather_ps(off, base, 4);
+        c100 = _mm512_i32gather_ps(off, base + 1, 4);
+        c010 = _mm512_i32gather_ps(o1, base, 4);
+        c110 = _mm512_i32gather_ps(o1, base + 1, 4);
+        c001 = _mm512_i32gather_ps(o2, base, 4);
+        c101 = _mm512_i32gather_ps(o2, base + 1, 4);
+        c011 = _mm512_i32gather_ps(o3, base, 4);
+        c111 = _mm512_i32gather_ps(o3, base + 1, 4);
+    }
+    const __m512 c00 = _mm512_add_ps(c000, _mm512_mul_ps(fx, _mm512_sub_ps(c100, c000)));
+    const __m512 c10 = _mm512_add_ps(c010, _mm512_mul_ps(fx, _mm512_sub_ps(c110, c010)));
+    const __m512 c01 = _mm512_add_ps(c001, _mm512_mul_ps(fx, _mm512_sub_ps(c101, c001)));
+    const __m512 c11 = _mm512_add_ps(c011, _mm512_mul_ps(fx, _mm512_sub_ps(c111, c011)));
+    const __m512 c0 = _mm512_add_ps(c00, _mm512_mul_ps(fy, _mm512_sub_ps(c10, c00)));
+    const __m512 c1 = _mm512_add_ps(c01, _mm512_mul_ps(fy, _mm512_sub_ps(c11, c01)));
+    return _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
+}
+
 template <bool kNearest, class T, class Refill>
 LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                                 Refill& refill) {
@@ -521,8 +624,6 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
     const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
                  vhi2 = _mm512_set1_ps(g.hi[2]);
-    const __m512i vc0 = _mm512_set1_epi32(g.cell[0]), vc1 = _mm512_set1_epi32(g.cell[1]),
-                  vc2 = _mm512_set1_epi32(g.cell[2]);
     const __m512i vsy = _mm512_set1_epi32(g.sy), vsz = _mm512_set1_epi32(g.sz);
     const __m512 voff = _mm512_set1_ps(g.lut_offset), vscale = _mm512_set1_ps(g.lut_scale),
                  vlast = _mm512_set1_ps(g.lut_last);
@@ -542,10 +643,6 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     aa = _mm512_load_ps(s.a);
     int waiting = 0;
     LACUNA_LOAD_LANES
-    constexpr bool kByte = sizeof(T) == 1;
-    // Offsets of the corner pairs past the first (float voxels gather them).
-    const __m512i q1 = _mm512_set1_epi32(g.sy), q2 = _mm512_set1_epi32(g.sz),
-                  q3 = _mm512_set1_epi32(g.sy + g.sz);
     int need;
     for (;;) {
         const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
@@ -575,98 +672,7 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
                 v = _mm512_load_ps(vals);
             }
         } else {
-            const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), vc0);
-            const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), vc1);
-            const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(z), vc2);
-            const __m512 fx = _mm512_sub_ps(x, _mm512_cvtepi32_ps(ci));
-            const __m512 fy = _mm512_sub_ps(y, _mm512_cvtepi32_ps(cj));
-            const __m512 fz = _mm512_sub_ps(z, _mm512_cvtepi32_ps(ck));
-            __m512i off = _mm512_add_epi32(
-                _mm512_add_epi32(_mm512_mullo_epi32(ck, vsz), _mm512_mullo_epi32(cj, vsy)), ci);
-            off = _mm512_maskz_mov_epi32(active, off);  // idle lanes read voxel 0
-            __m512 c000, c100, c010, c110, c001, c101, c011, c111;
-            if constexpr (kByte) {
-                // Corner pairs by 16-bit scalar loads into a table (trilinear8's way; cheaper than
-                // four sixteen-lane gathers here), widened: low byte voxel i, high byte voxel i + 1.
-                alignas(64) int32_t ofs[16];
-                alignas(32) uint16_t wp[4][16];
-                _mm512_store_si512(ofs, off);
-                const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-                for (int l = 0; l < 16; ++l) {
-                    const T* p = data + ofs[l];
-                    __builtin_memcpy(&wp[0][l], p, 2);
-                    __builtin_memcpy(&wp[1][l], p + psy, 2);
-                    __builtin_memcpy(&wp[2][l], p + psz, 2);
-                    __builtin_memcpy(&wp[3][l], p + psyz, 2);
-                }
-                const __m512i m = _mm512_set1_epi32(0xff);
-                const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
-                const __m512i w1 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
-                const __m512i w2 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[2])));
-                const __m512i w3 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[3])));
-                c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
-                c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 8));
-                c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
-                c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 8));
-                c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
-                c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 8));
-                c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
-                c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 8));
-            } else if constexpr (sizeof(T) == 2) {
-                // 16-bit voxels: each corner pair is one 32-bit scalar load, into a table.
-                alignas(64) int32_t ofs[16];
-                alignas(64) int32_t wq[4][16];
-                _mm512_store_si512(ofs, off);
-                const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-                for (int l = 0; l < 16; ++l) {
-                    const T* p = data + ofs[l];
-                    __builtin_memcpy(&wq[0][l], p, 4);
-                    __builtin_memcpy(&wq[1][l], p + psy, 4);
-                    __builtin_memcpy(&wq[2][l], p + psz, 4);
-                    __builtin_memcpy(&wq[3][l], p + psyz, 4);
-                }
-                const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
-                const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
-                if constexpr (std::is_signed_v<T>) {
-                    c000 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w0, 16), 16));
-                    c010 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w1, 16), 16));
-                    c001 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w2, 16), 16));
-                    c011 = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w3, 16), 16));
-                    c100 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w0, 16));
-                    c110 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w1, 16));
-                    c101 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w2, 16));
-                    c111 = _mm512_cvtepi32_ps(_mm512_srai_epi32(w3, 16));
-                } else {
-                    const __m512i m = _mm512_set1_epi32(0xffff);
-                    c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
-                    c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
-                    c001 = _mm512_cvtepi32_ps(_mm512_and_si512(w2, m));
-                    c011 = _mm512_cvtepi32_ps(_mm512_and_si512(w3, m));
-                    c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 16));
-                    c110 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w1, 16));
-                    c101 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w2, 16));
-                    c111 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w3, 16));
-                }
-            } else {
-                const float* base = reinterpret_cast<const float*>(data);
-                const __m512i o1 = _mm512_add_epi32(off, q1), o2 = _mm512_add_epi32(off, q2),
-                              o3 = _mm512_add_epi32(off, q3);
-                c000 = _mm512_i32gather_ps(off, base, 4);
-                c100 = _mm512_i32gather_ps(off, base + 1, 4);
-                c010 = _mm512_i32gather_ps(o1, base, 4);
-                c110 = _mm512_i32gather_ps(o1, base + 1, 4);
-                c001 = _mm512_i32gather_ps(o2, base, 4);
-                c101 = _mm512_i32gather_ps(o2, base + 1, 4);
-                c011 = _mm512_i32gather_ps(o3, base, 4);
-                c111 = _mm512_i32gather_ps(o3, base + 1, 4);
-            }
-            const __m512 c00 = _mm512_add_ps(c000, _mm512_mul_ps(fx, _mm512_sub_ps(c100, c000)));
-            const __m512 c10 = _mm512_add_ps(c010, _mm512_mul_ps(fx, _mm512_sub_ps(c110, c010)));
-            const __m512 c01 = _mm512_add_ps(c001, _mm512_mul_ps(fx, _mm512_sub_ps(c101, c001)));
-            const __m512 c11 = _mm512_add_ps(c011, _mm512_mul_ps(fx, _mm512_sub_ps(c111, c011)));
-            const __m512 c0 = _mm512_add_ps(c00, _mm512_mul_ps(fy, _mm512_sub_ps(c10, c00)));
-            const __m512 c1 = _mm512_add_ps(c01, _mm512_mul_ps(fy, _mm512_sub_ps(c11, c01)));
-            v = _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
+            v = trilinear16(g, data, x, y, z, active);
         }
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
         u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
