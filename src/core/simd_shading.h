@@ -482,6 +482,52 @@ LACUNA_AVX2 inline void pbr8(const PbrLanes& p, const ShadeLight& L, const float
     }
 }
 
+// ---- AVX-512: the lattice batch in sixteen lanes -----------------------------------------
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// samples8's sixteen-lane twin: ShadedStream's whole lattice batch in one call on AVX-512 CPUs
+// (march_lanes16's trilinear16; the same operations per lane).
+template <class T>
+LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
+                            float* x, float* y, float* z, float* v, int32_t* e) {
+    const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f);
+    const __m512 t = _mm512_add_ps(
+        _mm512_set1_ps(r.t_base),
+        _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(_mm512_loadu_si512(k)), half), _mm512_set1_ps(r.dt)));
+    const __m512 px = _mm512_add_ps(_mm512_set1_ps(r.o[0]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[0])));
+    const __m512 py = _mm512_add_ps(_mm512_set1_ps(r.o[1]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[1])));
+    const __m512 pz = _mm512_add_ps(_mm512_set1_ps(r.o[2]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[2])));
+    _mm512_storeu_ps(x, px), _mm512_storeu_ps(y, py), _mm512_storeu_ps(z, pz);
+    const __m512 cx = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), px));
+    const __m512 cy = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), py));
+    const __m512 cz = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), pz));
+    if (g.cell_mask) {
+        // The cells trilinear16 reads, one gather from the mask.
+        const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(cx), _mm512_set1_epi32(g.cell[0]));
+        const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(cy), _mm512_set1_epi32(g.cell[1]));
+        const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(cz), _mm512_set1_epi32(g.cell[2]));
+        const __m512i off = _mm512_add_epi32(
+            _mm512_add_epi32(_mm512_mullo_epi32(ck, _mm512_set1_epi32(g.sz)),
+                             _mm512_mullo_epi32(cj, _mm512_set1_epi32(g.sy))),
+            ci);
+        const __m512i w = _mm512_i32gather_epi32(_mm512_srli_epi32(off, 5), g.cell_mask, 4);
+        const __m512i bit = _mm512_and_si512(_mm512_srlv_epi32(w, _mm512_and_si512(off, _mm512_set1_epi32(31))),
+                                             _mm512_set1_epi32(1));
+        if (!_mm512_test_epi32_mask(bit, bit)) return 0;
+    }
+    const __m512 val = trilinear16(g, data, cx, cy, cz, __mmask16(0xffff));
+    _mm512_storeu_ps(v, val);
+    __m512 u = _mm512_add_ps(
+        _mm512_mul_ps(_mm512_sub_ps(val, _mm512_set1_ps(g.lut_offset)), _mm512_set1_ps(g.lut_scale)), half);
+    u = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.lut_last), u));
+    const __m512i ent = _mm512_cvttps_epi32(u);
+    _mm512_storeu_si512(e, ent);
+    const __m512 a = _mm512_i32gather_ps(_mm512_slli_epi32(ent, 2), g.alpha, 4);
+    return int(_mm512_cmp_ps_mask(a, zero, _CMP_GT_OQ));
+}
+#pragma GCC diagnostic pop
+
 #endif  // LACUNA_SIMD_X86
 
 }  // namespace lacuna::simd

@@ -334,6 +334,7 @@ struct ShadeOps;
 template <>
 struct ShadeOps<4> {
     static constexpr bool kShades = false;  // scalar shading (phong_h, pbr_h)
+    static constexpr int kLatticeLanes = kShadeBatch;  // samples() takes half a lattice batch
     static void phong(const simd::PhongLanes&, const simd::ShadeLight&, const float*, const float*,
                       const float*, float*, float*, float*, int) {}
     static void pbr(const simd::PbrLanes&, const simd::ShadeLight&, const float*, const float*,
@@ -365,6 +366,7 @@ struct ShadeOps<4> {
 template <>
 struct ShadeOps<8> {
     static constexpr bool kShades = true;  // simd::phong8, simd::pbr8
+    static constexpr int kLatticeLanes = kShadeBatch;
     static void phong(const simd::PhongLanes& p, const simd::ShadeLight& L, const float* gx,
                       const float* gy, const float* gz, float* r, float* g, float* b, int n) {
         simd::phong8(p, L, gx, gy, gz, r, g, b, n);
@@ -388,6 +390,17 @@ struct ShadeOps<8> {
                                  const float* x, const float* y, const float* z, float* gx,
                                  float* gy, float* gz, int) {
         simd::volume_gradients8(g, grad, x, y, z, gx, gy, gz);
+    }
+};
+// AVX-512 CPUs: ShadeOps<8>, with the whole lattice batch in sixteen lanes.
+template <>
+struct ShadeOps<16> : ShadeOps<8> {
+    static constexpr int kLatticeLanes = kLatticeBatch;
+    template <class T>
+    static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
+                            const int32_t* k, float* x, float* y, float* z, float* v,
+                            int32_t* e, int) {
+        return unsigned(simd::samples16(g, r, d, k, x, y, z, v, e));
     }
 };
 #endif
@@ -465,7 +478,7 @@ private:
         alignas(32) float x[kLatticeBatch], y[kLatticeBatch], z[kLatticeBatch], v[kLatticeBatch];
         alignas(32) int32_t e[kLatticeBatch];  // c.map(v), in lanes
         unsigned visible = Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, e, std::min(m, kShadeBatch));
-        if (m > kShadeBatch)
+        if (Ops::kLatticeLanes < kLatticeBatch && m > kShadeBatch)
             visible |= Ops::samples(m_sg, m_sr, m_data, m_k + kShadeBatch, x + kShadeBatch,
                                     y + kShadeBatch, z + kShadeBatch, v + kShadeBatch,
                                     e + kShadeBatch, m - kShadeBatch)

@@ -235,8 +235,8 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             };
             const simd::Isa isa = batched ? simd::active_isa() : simd::Isa::Scalar;
 #if LACUNA_SIMD_X86
-            if (isa == simd::Isa::Avx2 || isa == simd::Isa::Avx512)
-                return frame(std::type_identity<feature::ShadeOps<8>>{});
+            if (isa == simd::Isa::Avx512) return frame(std::type_identity<feature::ShadeOps<16>>{});
+            if (isa == simd::Isa::Avx2) return frame(std::type_identity<feature::ShadeOps<8>>{});
 #if defined(__SSE4_1__)
             if (isa == simd::Isa::Sse41) return frame(std::type_identity<feature::ShadeOps<4>>{});
 #endif
