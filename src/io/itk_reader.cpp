@@ -119,7 +119,9 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
 
     // Our checks of the header run before ITK parses it (docs/formats.md): NDims for MetaIO,
     // and where a detached NRRD header's data files are.
-    if (dynamic_cast<itk::MetaImageIO*>(io.GetPointer())) check_metaimage_header(path);
+    std::optional<MetaHeaderOrientation> meta_orientation;
+    if (dynamic_cast<itk::MetaImageIO*>(io.GetPointer()))
+        meta_orientation = check_metaimage_header(path);
     std::vector<std::string> nrrd_files;
     if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
         quiet.reset();
@@ -162,6 +164,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     Volume v(dims, stored_type(disk), path);
     copy_geometry(*io, v);
     v.geometry_source = geometry_source(path);
+    if (meta_orientation) apply_anatomical_orientation(*meta_orientation, v, path);
     if (meta) {
         quiet.reset();
         read_metaimage_voxels(*meta, disk, v, path, opts.progress);

@@ -13,6 +13,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -88,7 +89,8 @@ class Inflater {
 
 }  // namespace
 
-void check_metaimage_header(const std::string& path) {
+MetaHeaderOrientation check_metaimage_header(const std::string& path) {
+    MetaHeaderOrientation orientation;
     // Headers are a few hundred bytes: look at the first MiB, up to ElementDataFile (the last
     // key). MetaIO parses on past where we stop, so a header without ElementDataFile there is
     // rejected here rather than parsed by MetaIO unchecked.
@@ -117,7 +119,10 @@ void check_metaimage_header(const std::string& path) {
                             std::to_string(std::max(key.size(), value.size())) +
                             " characters, MetaImage allows " + std::to_string(kMaxField));
         if (eq == std::string::npos) continue;
-        if (to_lower(key) == "elementdatafile") return;
+        if (to_lower(key) == "elementdatafile") return orientation;
+        if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
+            orientation.has_matrix = true;
+        if (key == "AnatomicalOrientation") orientation.anatomical_orientation = value;
         if (to_lower(key) != "ndims") continue;
         if (value != "3" && value != "4")
             throw Error(path, "header",
@@ -125,6 +130,68 @@ void check_metaimage_header(const std::string& path) {
                             one_line(value, 40) + "'");
     }
     throw Error(path, "header", "no ElementDataFile line in the first MiB of the header");
+}
+
+namespace {
+
+// The MetaIO code of an LPS direction: for each index axis (column), the letter of the side it
+// comes from along its largest component (+x LPS runs from R to L: 'R').
+std::string metaio_code(const double* direction) {
+    const char from[3][2] = {{'R', 'L'}, {'A', 'P'}, {'I', 'S'}};  // [LPS axis][+, -]
+    std::string code;
+    for (int c = 0; c < 3; ++c) {
+        int best = 0;
+        for (int r = 1; r < 3; ++r)
+            if (std::abs(direction[r * 3 + c]) > std::abs(direction[best * 3 + c])) best = r;
+        code += from[best][direction[best * 3 + c] < 0];
+    }
+    return code;
+}
+
+}  // namespace
+
+void apply_anatomical_orientation(const MetaHeaderOrientation& h, Volume& v,
+                                  const std::string& path) {
+    const std::string& ao = h.anatomical_orientation;
+    if (ao.empty() || ao.find_first_not_of('?') == std::string::npos) return;
+    // For each letter: the LPS axis and the sign of the direction the index axis points in.
+    auto axis_of = [](char c, int& axis, double& sign) {
+        const char* letters = "RLAPIS";  // from R: +x (toward L); from L: -x; from A: +y; ...
+        const char* p = std::strchr(letters, c);
+        if (c == '\0' || !p) return false;
+        axis = int(p - letters) / 2;
+        sign = (p - letters) % 2 ? -1.0 : 1.0;
+        return true;
+    };
+    double d[9] = {};
+    bool used[3] = {false, false, false};
+    bool ok = ao.size() >= 3 && ao.find_first_of(" \t") == std::string::npos;
+    for (int c = 0; ok && c < 3; ++c) {
+        int axis = 0;
+        double sign = 1;
+        ok = axis_of(ao[size_t(c)], axis, sign) && !used[axis];
+        if (ok) used[axis] = true, d[axis * 3 + c] = sign;
+    }
+    // A 4D file (last size 1) may name a fourth axis: anything after the third letter is ignored.
+    if (!ok)
+        throw Error(path, "AnatomicalOrientation",
+                    "expected three letters, one of R/L, A/P and S/I each, naming the side each "
+                    "axis comes from (RAI: x from right to left, y from anterior to posterior, z "
+                    "from inferior to superior), got '" +
+                        one_line(ao, 40) + "'");
+    const std::string code = ao.substr(0, 3);
+    if (!h.has_matrix) {
+        for (int i = 0; i < 9; ++i) v.direction[i] = d[i];
+        v.geometry_source = "MetaImage AnatomicalOrientation " + code +
+                            " (no TransformMatrix; MetaIO letters: the side each axis comes "
+                            "from) and Offset, LPS";
+        return;
+    }
+    const std::string from_matrix = metaio_code(v.direction);
+    if (from_matrix != code)
+        v.geometry_source += "; AnatomicalOrientation " + code +
+                             " disagrees with TransformMatrix (" + from_matrix +
+                             " in MetaIO letters): TransformMatrix wins, as in ITK";
 }
 
 std::optional<MetaDataLayout> metaimage_layout(const std::string& header_path,

@@ -23,8 +23,22 @@ struct MetaDataLayout {
 // field buffers (a 256-character key or value aborted the process through glibc's fortify
 // check, found by fuzz_metaimage): every key and value up to ElementDataFile is at most 254
 // characters, and ElementDataFile must come within the first MiB. Call before ITK reads the
-// header.
-void check_metaimage_header(const std::string& path);
+// header. Returns what the header says about orientation (below).
+struct MetaHeaderOrientation {
+    bool has_matrix = false;             // TransformMatrix (or its synonyms Rotation, Orientation)
+    std::string anatomical_orientation;  // the raw AnatomicalOrientation value ("" when absent)
+};
+MetaHeaderOrientation check_metaimage_header(const std::string& path);
+
+// Applies AnatomicalOrientation to v's LPS direction (read from TransformMatrix by ITK). MetaIO's
+// letters name the side each index axis comes FROM: "RAI" = x from right to left, y from anterior
+// to posterior, z from inferior to superior, i.e. LPS+ identity (what ITK writes for it). Without
+// a TransformMatrix (which MetaIO then takes as identity) the letters define the axes; with both,
+// TransformMatrix wins (ITK and every ITK-based tool read only it) and a disagreement is noted in
+// v.geometry_source. Throws Error(path, "AnatomicalOrientation", ...) for a value that is not
+// three letters, one of R/L, A/P and S/I each ("???" and an absent field mean none).
+void apply_anatomical_orientation(const MetaHeaderOrientation& h, Volume& v,
+                                  const std::string& path);
 
 // Locates the voxel data described by a parsed MetaImage header; nullopt for ASCII voxels,
 // which MetaIO parses. An external data file must pass check_data_file (detached_data.h);
