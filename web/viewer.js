@@ -14,6 +14,10 @@
   const view = $('view'), img = $('frame');
   const tfCanvas = $('tf'), colorCanvas = $('colors');
 
+  // Named anatomical views (lacuna/views.h): azimuth about superior from the anterior view.
+  const kViews = { anterior: [0, 0], posterior: [180, 0], left: [90, 0], right: [270, 0],
+                   superior: [0, 90], inferior: [0, -90] };
+
   const state = {
     camera: { azimuth: 30, elevation: 15, zoom: 1, pan: [0, 0] },
     renderer: 'march',
@@ -21,6 +25,7 @@
     ert: true,
     shading: false,
     clip: false,
+    clipPlanes: [],  // world planes [nx, ny, nz, d] in patient RAS mm (lacuna render --clip)
     segments: false,
     hide: '',
     step: 0.5,
@@ -135,7 +140,7 @@
       type: 'render', id, width: w, height: h, preview: dirtyPreview,
       camera: state.camera, renderer: state.renderer, accel: state.accel,
       ert: state.ert, step: state.step, tf: state.tf, shading: state.shading, clip: state.clip,
-      segments: state.segments, hide: state.hide,
+      clip_planes: state.clipPlanes, segments: state.segments, hide: state.hide,
     }));
     inFlight = id;
     dirty = false;
@@ -192,6 +197,14 @@
       panBy(dx, dy);
     } else {
       $('view-name').value = '';
+      if (cam.view) {
+        // Leave the named view for free angles, starting where it is (free elevation stops at
+        // +-89.9 in the protocol; the page keeps to +-89).
+        const [az, el] = kViews[cam.view];
+        delete cam.view;
+        cam.azimuth = az;
+        cam.elevation = clamp(el, -89, 89);
+      }
       cam.azimuth = (cam.azimuth - dx * 0.4) % 360;
       cam.elevation = clamp(cam.elevation + dy * 0.4, -89, 89);
     }
@@ -246,7 +259,7 @@
       // The slicer renders boxes: the whole volume (none) or the kd-tree's; no shading/clipping.
       if (state.accel !== 'none' && state.accel !== 'kdtree') state.accel = 'kdtree';
       $('accel').value = state.accel;
-      state.shading = state.clip = false;
+      state.shading = state.clip = false; state.clipPlanes = []; $('clip-planes').value = '';
       $('shading').checked = $('clip').checked = false;
       state.segments = false;
       $('segments').checked = false;
@@ -269,23 +282,31 @@
     state.segments = e.target.checked;
     if (state.segments) {
       marchIfSlicer();
-      state.shading = state.clip = false;
+      state.shading = state.clip = false; state.clipPlanes = []; $('clip-planes').value = '';
       $('shading').checked = $('clip').checked = false;
     }
     request(false);
   });
   $('hide').addEventListener('change', (e) => { state.hide = e.target.value.trim(); request(false); });
   $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; if (state.shading) { marchIfSlicer(); noSegments(); } request(false); });
-  // Named anatomical views (lacuna render --view): azimuth about superior from the anterior
-  // view, elevation toward superior (the orbit stops at +-89 degrees).
-  const kViews = { anterior: [0, 0], posterior: [180, 0], left: [90, 0], right: [270, 0],
-                   superior: [0, 89], inferior: [0, -89] };
+  // Named anatomical views: the page sends the name ("camera": {"view": "left", ...}) and the
+  // server takes the angles from the table `lacuna render --view` uses (lacuna/views.h), so a
+  // view here is the CLI's view bit for bit. These angles only seed a drag away from the view.
   $('view-name').addEventListener('change', (e) => {
-    const v = kViews[e.target.value];
-    if (!v) return;
-    state.camera.azimuth = v[0];
-    state.camera.elevation = v[1];
-    state.camera.pan = [0, 0];
+    if (!kViews[e.target.value]) return;
+    state.camera = { view: e.target.value, zoom: state.camera.zoom, pan: [0, 0] };
+    request(false);
+  });
+  // Clip planes in world (patient RAS) mm, "NX,NY,NZ,D; ..." as lacuna render --clip: each keeps
+  // dot(n, p) >= D. Anything else marks the field invalid and sends no planes.
+  $('clip-planes').addEventListener('change', (e) => {
+    const text = e.target.value.trim();
+    const planes = text === '' ? [] : text.split(';').map((t) => t.split(',').map(Number));
+    const ok = planes.every((p) => p.length === 4 && p.every(Number.isFinite) &&
+                                   (p[0] !== 0 || p[1] !== 0 || p[2] !== 0));
+    e.target.classList.toggle('invalid', !ok);
+    state.clipPlanes = ok ? planes : [];
+    if (ok && planes.length) { marchIfSlicer(); noSegments(); }
     request(false);
   });
   $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; if (state.clip) { marchIfSlicer(); noSegments(); } request(false); });

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "lacuna/error.h"
+#include "lacuna/views.h"
 
 namespace lacuna::cli {
 
@@ -143,23 +144,9 @@ Progress::~Progress() {
 }
 
 void parse_view(const std::string& name, float& azimuth, float& elevation) {
-    struct View {
-        const char* name;
-        float azimuth, elevation;
-    };
-    // Azimuth about superior (+z) from the anterior view, toward the patient's left.
-    static const View views[] = {{"anterior", 0.f, 0.f},  {"posterior", 180.f, 0.f},
-                                 {"left", 90.f, 0.f},     {"right", 270.f, 0.f},
-                                 {"superior", 0.f, 90.f}, {"inferior", 0.f, -90.f}};
-    for (const View& v : views)
-        if (name == v.name) {
-            azimuth = v.azimuth;
-            elevation = v.elevation;
-            return;
-        }
-    throw Error(
-        "--view", "view",
-        "expected anterior, posterior, left, right, superior or inferior, got '" + name + "'");
+    if (!named_view(name, azimuth, elevation))
+        throw Error("--view", "view",
+                    std::string("expected ") + kViewNames + ", got '" + name + "'");
 }
 
 }  // namespace lacuna::cli

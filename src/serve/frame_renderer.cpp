@@ -96,6 +96,9 @@ RenderOptions FrameRenderer::render_options(const ViewRequest& req) const {
         const Box3f b = m_marcher->bounds();
         ro.features.clip_planes.push_back(ClipPlane{{-1.f, 0.f, 0.f}, -b.center().x});
     }
+    // World (patient RAS mm) planes, as `lacuna render --clip`: the renderer moves them into
+    // the volume frame with the camera (docs/formats.md, World frame).
+    for (const ClipPlane& p : req.clip_planes) ro.features.clip_planes.push_back(p);
     return ro;
 }
 

@@ -1,12 +1,12 @@
 #include "serve/protocol.h"
 
-#include "lacuna/segments.h"
-
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "lacuna/error.h"
+#include "lacuna/segments.h"
+#include "lacuna/views.h"
 
 namespace lacuna::serve {
 
@@ -133,7 +133,7 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     if (type != "render") reject("type", "unknown message type '" + type + "'; expected render");
     only_keys(j,
               {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
-               "step", "tf", "shading", "clip", "segments", "hide"},
+               "step", "tf", "shading", "clip", "clip_planes", "segments", "hide"},
               "");
     ViewRequest r;
     r.id = id_of(j);
@@ -142,9 +142,18 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     r.preview = boolean(j, "preview", "");
     const json& cam = need(j, "camera", "");
     if (!cam.is_object()) reject("camera", "expected an object");
-    only_keys(cam, {"azimuth", "elevation", "zoom", "pan"}, "camera.");
-    r.camera.azimuth = float(number(cam, "azimuth", -1e6, 1e6, "camera."));
-    r.camera.elevation = float(number(cam, "elevation", -89.9, 89.9, "camera."));
+    only_keys(cam, {"view", "azimuth", "elevation", "zoom", "pan"}, "camera.");
+    if (cam.contains("view")) {
+        // The named views of `lacuna render --view`, from the same table.
+        const std::string view = text_of(cam, "view", "camera.");
+        if (cam.contains("azimuth") || cam.contains("elevation"))
+            reject("camera.view", "sets azimuth and elevation; send either the view or the angles");
+        if (!named_view(view, r.camera.azimuth, r.camera.elevation))
+            reject("camera.view", "unknown '" + view.substr(0, 40) + "'; expected " + kViewNames);
+    } else {
+        r.camera.azimuth = float(number(cam, "azimuth", -1e6, 1e6, "camera."));
+        r.camera.elevation = float(number(cam, "elevation", -89.9, 89.9, "camera."));
+    }
     r.camera.zoom = float(number(cam, "zoom", 0.05, 50, "camera."));
     const json& pan = need(cam, "pan", "camera.");
     if (!pan.is_array() || pan.size() != 2 || !pan[0].is_number() || !pan[1].is_number())
@@ -170,6 +179,29 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     // the volume's centre that removes the half with x > centre (a cut-away of a head).
     if (j.contains("shading")) r.shading = boolean(j, "shading", "");
     if (j.contains("clip")) r.clip = boolean(j, "clip", "");
+    if (j.contains("clip_planes")) {
+        // World planes in patient RAS mm, as `lacuna render --clip NX,NY,NZ,D`.
+        const json& planes = need(j, "clip_planes", "");
+        if (!planes.is_array() || planes.size() > size_t(limits.max_clip_planes))
+            reject("clip_planes", "expected an array of at most " +
+                                      std::to_string(limits.max_clip_planes) +
+                                      " planes [nx, ny, nz, d]");
+        for (const json& p : planes) {
+            bool ok = p.is_array() && p.size() == 4;
+            for (size_t i = 0; ok && i < 4; ++i)
+                ok = p[i].is_number() && std::isfinite(p[i].get<double>()) &&
+                     std::abs(p[i].get<double>()) <= 1e9;
+            if (ok)
+                ok = p[0].get<double>() != 0 || p[1].get<double>() != 0 || p[2].get<double>() != 0;
+            if (!ok)
+                reject("clip_planes",
+                       "expected [nx, ny, nz, d]: finite numbers (RAS mm), a non-zero "
+                       "normal; got " +
+                           p.dump().substr(0, 80));
+            r.clip_planes.push_back(ClipPlane{
+                {p[0].get<float>(), p[1].get<float>(), p[2].get<float>()}, p[3].get<float>()});
+        }
+    }
     if (j.contains("segments")) r.segments = boolean(j, "segments", "");
     if (j.contains("hide")) {
         r.hide = text_of(j, "hide", "");
@@ -183,13 +215,15 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
             }
         }
     }
-    if (r.segments && (r.shading || r.clip || r.renderer == RendererKind::Slice))
+    const bool clipped = r.clip || !r.clip_planes.empty();
+    if (r.segments && (r.shading || clipped || r.renderer == RendererKind::Slice))
         reject("segments", "segments are drawn by the ray marcher without shading or clipping");
     if (r.renderer == RendererKind::Slice) {
         if (r.accel != AccelKind::None && r.accel != AccelKind::KdTree)
             reject("accel", "the slice renderer takes none (Basic) or kdtree, not '" +
                                 to_string(r.accel) + "'");
-        if (r.shading || r.clip) reject("renderer", "the slice renderer has no shading or clipping");
+        if (r.shading || clipped)
+            reject("renderer", "the slice renderer has no shading or clipping");
     }
     r.step = float(number(j, "step", 0.1, 8, ""));
 

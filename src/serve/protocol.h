@@ -5,8 +5,12 @@
 // Page -> server (text, one JSON object, at most Limits::max_message_bytes):
 //   {"type":"render", "id":N, "width":W, "height":H, "preview":bool,
 //    "camera":{"azimuth":deg, "elevation":deg, "zoom":f, "pan":[x,y]},
+//      or "camera":{"view":"left", "zoom":f, "pan":[x,y]}: a named view of `lacuna render --view`
+//      (anterior, posterior, left, right, superior, inferior; lacuna/views.h) instead of angles,
 //    "renderer":"march", "accel":"bitfield", "ert":bool, "step":f,
-//    ["shading":bool, "clip":bool, "segments":bool, "hide":"1,2,37-42"]  (optional, off when absent)
+//    ["shading":bool, "clip":bool, "segments":bool, "hide":"1,2,37-42",
+//     "clip_planes":[[nx,ny,nz,d], ...]]  (optional, off when absent; planes are `--clip`: world
+//                                          patient RAS mm, keeping dot(n, p) >= d)
 //    "tf":{...the transfer-function JSON of docs/transfer-functions.md...}}
 //   Every request carries the whole view state, so the server can drop all but the latest.
 //   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "lacuna/accel.h"
+#include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
 
@@ -41,12 +46,15 @@ struct Limits {
     size_t max_message_bytes = 64 * 1024;  // a WebSocket message from the page
     int max_side = 4096;                   // requested image width/height
     int max_tf_points = 512;               // colour + opacity points of one TF
+    int max_clip_planes = 6;               // "clip_planes" of one request
 };
 
 struct ViewCamera {
     float azimuth = 30.f, elevation = 15.f;  // degrees
     float zoom = 1.f;                        // (0.05, 50]
     float pan_x = 0.f, pan_y = 0.f;          // along the view's right/up, in bounding radii
+    // A named view sets azimuth and elevation from lacuna/views.h (superior and inferior are
+    // exactly +-90, which free angles may not reach: they stop at +-89.9).
     friend bool operator==(const ViewCamera&, const ViewCamera&) = default;
 };
 
@@ -61,6 +69,8 @@ struct ViewRequest {
     float step = 0.5f;  // sample distance in smallest voxel spacings, [0.1, 8]
     bool shading = false;  // optional "shading": Phong with a headlight (docs/shading.md)
     bool clip = false;     // optional "clip": keep x <= the volume's centre (a cut-away)
+    // optional "clip_planes": world (patient RAS mm) planes, `lacuna render --clip NX,NY,NZ,D`
+    std::vector<ClipPlane> clip_planes;
     bool segments = false;  // optional "segments": mask by the server's label volume (--labels)
     std::string hide;       // optional "hide": labels to hide, "1,2,37-42" (docs/segments.md)
     TransferFunction tf;

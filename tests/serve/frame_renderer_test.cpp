@@ -7,12 +7,16 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
+#include "../render/orientation_test_util.h"
 #include "lacuna/error.h"
 #include "lacuna/io.h"
 #include "lacuna/synthetic.h"
 #include "serve/jpeg.h"
+#include "serve/protocol.h"
 
 namespace fs = std::filesystem;
 using namespace lacuna;
@@ -177,6 +181,85 @@ TEST(FrameRenderer, ClipPlaneAndViewsAreInPatientRasOnAnLpsVolume) {
     req.shading = true;
     req.clip = true;
     EXPECT_EQ(fr.render(req, 40, 36).image.rgba, read_png(out.string()).rgba);
+}
+
+// Orientation round-trips through the viewer (issue 14, item 6). The page's request, parsed by the
+// protocol, with a named view and a world clip plane, is the frame `lacuna render --view V --clip
+// ...` writes, byte for byte, on the asymmetric phantom stored LPS; and a plane, in patient RAS
+// mm, cuts the same side of the anatomy whatever the storage: seen with a TF that shows only the
+// marker on the patient's right (at x = +11), x <= 0 removes it and x >= 0 keeps it, on the RAS
+// file and on its LPS copy alike, and both give the picture of the same voxels without geometry
+// (world = index x spacing, no map) clipped by the same plane moved by the origin.
+TEST(FrameRenderer, NamedViewsAndWorldClipPlanesRoundTripThroughTheProtocol) {
+    namespace to = lacuna::test::orientation;
+    const Volume ras = to::phantom();
+    const fs::path ras_file = temp_dir() / "phantom-ras.nrrd",
+                   lps_file = temp_dir() / "phantom-lps.nrrd",
+                   tf_file = temp_dir() / "phantom.json";
+    write_volume(ras_file.string(), ras);
+    write_volume(lps_file.string(), to::reorder(ras, {0, 1, 2}, {true, true, false}));
+    std::ofstream(tf_file) << to_json(to::phantom_tf());
+    TransferFunction right_marker;  // opaque only at the right marker's values (220)
+    right_marker.name = "right-marker";
+    right_marker.domain = TfDomain::Value;
+    right_marker.color = {{0, 1, 0.2, 0.2}, {255, 1, 0.2, 0.2}};
+    right_marker.opacity = {{0, 0}, {180, 0}, {200, 0.9}, {255, 0.9}};
+    auto page_request = [](const char* view, const TransferFunction& tf, nlohmann::json planes) {
+        nlohmann::json j = {{"type", "render"}, {"id", 1},
+                            {"width", 48},      {"height", 40},
+                            {"preview", false}, {"renderer", "march"},
+                            {"accel", "grid"},  {"ert", false},
+                            {"step", 0.5},      {"tf", nlohmann::json::parse(to_json(tf))}};
+        j["camera"] = {{"view", view}, {"zoom", 1.5}, {"pan", {0, 0}}};
+        if (!planes.is_null()) j["clip_planes"] = planes;
+        return parse_request(j.dump());
+    };
+    const nlohmann::json keep_left = {{-1, 0, 0, 0}}, keep_right = {{1, 0, 0, 0}};
+    FrameRenderer lps(read_volume(lps_file.string())), rasr(read_volume(ras_file.string()));
+    for (const char* view : {"left", "superior", "anterior"}) {
+        const fs::path out = temp_dir() / (std::string("cli_view_") + view + ".png");
+        const std::string cmd =
+            std::string(LACUNA_CLI_PATH) + " render " + lps_file.string() + " --tf " +
+            tf_file.string() + " --accel grid --width 48 --height 40 --view " + view +
+            " --zoom 1.5 --step 0.5 --ert 1 --clip -1,0,0,0 --out " + out.string() + " >/dev/null";
+        const int status = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
+        EXPECT_EQ(lps.render(page_request(view, to::phantom_tf(), keep_left), 48, 40).image.rgba,
+                  read_png(out.string()).rgba)
+            << view;
+    }
+    auto opaque = [](const Image& im) {  // the marker's red over the black background
+        int n = 0;
+        for (size_t p = 0; p < im.rgba.size(); p += 4) n += im.rgba[p] > 100;
+        return n;
+    };
+    for (FrameRenderer* fr : {&rasr, &lps}) {
+        const char* what = fr == &rasr ? "RAS" : "LPS";
+        EXPECT_GT(opaque(fr->render(page_request("anterior", right_marker, {}), 96, 80).image), 10)
+            << what << ": the right marker shows unclipped";
+        EXPECT_EQ(
+            opaque(fr->render(page_request("anterior", right_marker, keep_left), 96, 80).image), 0)
+            << what << ": x <= 0 removes the patient's right";
+        EXPECT_GT(
+            opaque(fr->render(page_request("anterior", right_marker, keep_right), 96, 80).image),
+            10)
+            << what << ": x >= 0 keeps it";
+    }
+    // The reference: the same voxels without geometry, whose volume frame is the world itself
+    // (nothing to map, so nothing to get wrong), shifted by the phantom's origin: RAS x there is
+    // x + 20, so the plane x <= 0 is -x >= -20.
+    Volume plain = ras;
+    plain.origin = Volume(ras.dims(), ras.type()).origin;
+    for (int i = 0; i < 9; ++i) plain.direction[i] = Volume(ras.dims(), ras.type()).direction[i];
+    FrameRenderer ref(std::move(plain));
+    const Image want =
+        ref.render(page_request("anterior", to::phantom_tf(), {{-1, 0, 0, -20}}), 48, 40).image;
+    to::expect_same_picture(
+        rasr.render(page_request("anterior", to::phantom_tf(), keep_left), 48, 40).image, want,
+        "clipped RAS file vs the plain voxels", false);
+    to::expect_same_picture(
+        lps.render(page_request("anterior", to::phantom_tf(), keep_left), 48, 40).image, want,
+        "clipped LPS copy vs the plain voxels", false);
 }
 
 TEST(FrameRenderer, EveryStructureMatchesNoneThroughTfChangesAndSwitches) {

@@ -9,6 +9,7 @@
 
 #include "lacuna/error.h"
 #include "lacuna/synthetic.h"
+#include "lacuna/views.h"
 
 using nlohmann::json;
 using namespace lacuna;
@@ -107,6 +108,55 @@ TEST(Protocol, ParsesTheOptionalShadingAndClipToggles) {
     j = good_request();
     j["clip"] = 1;
     expect_rejected(j, "clip");
+}
+
+// A named view is the CLI's --view: the same angles from one table (superior and inferior are
+// exactly +-90, beyond the +-89.9 free angles may reach); angles beside it are refused.
+TEST(Protocol, NamedViewsAreTheCliViews) {
+    for (const char* name : {"anterior", "posterior", "left", "right", "superior", "inferior"}) {
+        json j = good_request();
+        j["camera"] = {{"view", name}, {"zoom", 2}, {"pan", {0, 0}}};
+        const ViewRequest r = parse_request(j.dump());
+        float az = -1, el = -1;
+        ASSERT_TRUE(named_view(name, az, el));
+        EXPECT_EQ(r.camera.azimuth, az) << name;
+        EXPECT_EQ(r.camera.elevation, el) << name;
+        EXPECT_EQ(r.camera.zoom, 2.f);
+    }
+    json j = good_request();
+    j["camera"]["view"] = "superior";
+    j["camera"]["elevation"] = 90;
+    expect_rejected(j, "camera.view: sets azimuth and elevation");
+    j["camera"].erase("azimuth");
+    j["camera"].erase("elevation");
+    EXPECT_EQ(parse_request(j.dump()).camera.elevation, 90.f);
+    j["camera"]["view"] = "front";
+    expect_rejected(j, "camera.view: unknown 'front'; expected anterior, posterior");
+    j["camera"]["view"] = 3;
+    expect_rejected(j, "camera.view: expected a string");
+}
+
+// "clip_planes" are --clip planes, world RAS mm, each [nx, ny, nz, d]; nothing else parses.
+TEST(Protocol, ClipPlanesAreWorldPlanesLikeTheCliFlag) {
+    json j = good_request();
+    j["clip_planes"] = {{-1, 0, 0, 26}, {0, 0.5, 0.5, -3.25}};
+    const ViewRequest r = parse_request(j.dump());
+    ASSERT_EQ(r.clip_planes.size(), 2u);
+    EXPECT_EQ(r.clip_planes[0].normal, (Vec3f{-1, 0, 0}));
+    EXPECT_EQ(r.clip_planes[0].d, 26.f);
+    EXPECT_EQ(r.clip_planes[1].normal, (Vec3f{0, 0.5f, 0.5f}));
+    EXPECT_EQ(r.clip_planes[1].d, -3.25f);
+    EXPECT_TRUE(parse_request(good_request().dump()).clip_planes.empty());
+    for (const json& bad :
+         {json(1), json({{1, 0, 0}}), json({{0, 0, 0, 1}}), json({{1, 0, "0", 1}}),
+          json({{1, 0, 0, 1e300}}), json(std::vector<json>(7, {1, 0, 0, 0}))}) {
+        j["clip_planes"] = bad;
+        expect_rejected(j, "clip_planes: expected");
+    }
+    j["clip_planes"] = {{1, 0, 0, 0}};
+    j["renderer"] = "slice";
+    j["accel"] = "kdtree";
+    expect_rejected(j, "the slice renderer has no shading or clipping");
 }
 
 TEST(Protocol, EveryPresetRoundTripsThroughARequest) {
