@@ -39,27 +39,75 @@ struct Rgb {
 // The paper's colours: red uniform, blue gradient, green other (indexed by BoxType).
 constexpr Rgb kTypeColour[3] = {{235, 50, 50}, {70, 120, 255}, {40, 200, 60}};
 
+// How the picture lies in the anatomy (issue 14): the slice is across the index axis nearest the
+// patient's superior-inferior axis (an axial slice), seen from above with the patient's right to
+// the right of the screen and anterior up. The panel's columns and rows follow the index axes
+// nearest RAS x and y, reversed where they point left or posterior, so the same anatomy stored
+// in another voxel order (RAS, LPS, a permuted order) gives the same slice picture. A volume
+// without geometry is RAS: x right, y up, z the slice, as before orientation existed.
+struct SliceAxes {
+    int u = 0, v = 1, s = 2;  // index axes: screen right, screen up, across
+    bool flip_u = false, flip_v = false, flip_s = false;  // reversed against RAS +x, +y, +z
+};
+SliceAxes slice_axes(const Volume& vol) {
+    const Affine a = index_to_world(vol);
+    SliceAxes ax;
+    auto nearest = [&](int row, const bool* taken) {  // the free index axis most along RAS `row`
+        int best = -1;
+        for (int c = 0; c < 3; ++c)
+            if (!taken[c] && (best < 0 || std::abs(a.m[row][c]) / a.column_length(c) >
+                                              std::abs(a.m[row][best]) / a.column_length(best)))
+                best = c;
+        return best;
+    };
+    bool taken[3] = {false, false, false};
+    ax.s = nearest(2, taken);
+    taken[ax.s] = true;
+    ax.u = nearest(0, taken);
+    taken[ax.u] = true;
+    ax.v = nearest(1, taken);
+    ax.flip_s = a.m[2][ax.s] < 0;
+    ax.flip_u = a.m[0][ax.u] < 0;
+    ax.flip_v = a.m[1][ax.v] < 0;
+    return ax;
+}
+
 struct Panel {
     Image& img;
-    int x0, scale, cy;  // panel origin in the image, pixels per cell, cells in y (for the flip)
+    int x0, scale, cu, cv;  // panel origin in the image, pixels per cell, cells along u and v
+    SliceAxes ax;
     void px(int x, int y, Rgb c) const {
         if (x < 0 || y < 0 || x >= img.width || y >= img.height) return;
         uint8_t* p = img.pixel(x, y);
         p[0] = c.r, p[1] = c.g, p[2] = c.b, p[3] = 255;
     }
-    // Index-space x (0..cx) and y (0..cy) to pixels; y up.
+    // Screen coordinates (0..cu right, 0..cv up) of index coordinates along u and v.
+    int su(int i) const { return ax.flip_u ? cu - i : i; }
+    int sv(int j) const { return ax.flip_v ? cv - j : j; }
+    // Screen cell coordinates to pixels; y up.
     int X(int x) const { return x0 + x * scale; }
-    int Y(int y) const { return (cy - y) * scale; }
+    int Y(int y) const { return (cv - y) * scale; }
+    // A box's extent on the screen: [lo, hi] in screen cell coordinates along u and v.
+    void extent(const CellBox& b, int& ua, int& ub, int& va, int& vb) const {
+        ua = std::min(su(b.lo[ax.u]), su(b.hi[ax.u]));
+        ub = std::max(su(b.lo[ax.u]), su(b.hi[ax.u]));
+        va = std::min(sv(b.lo[ax.v]), sv(b.hi[ax.v]));
+        vb = std::max(sv(b.lo[ax.v]), sv(b.hi[ax.v]));
+    }
     void rect(const CellBox& b, Rgb c) const {
-        const int xa = X(b.lo[0]), xb = std::max(X(b.hi[0]) - 1, xa);
-        const int ya = Y(b.hi[1]), yb = std::max(Y(b.lo[1]) - 1, ya);
+        int ua, ub, va, vb;
+        extent(b, ua, ub, va, vb);
+        const int xa = X(ua), xb = std::max(X(ub) - 1, xa);
+        const int ya = Y(vb), yb = std::max(Y(va) - 1, ya);
         for (int x = xa; x <= xb; ++x) px(x, ya, c), px(x, yb, c);
         for (int y = ya; y <= yb; ++y) px(xa, y, c), px(xb, y, c);
     }
     // Tints a box's inside dark violet (boxes the source skips under the TF).
     void tint(const CellBox& b) const {
-        for (int y = Y(b.hi[1]); y < Y(b.lo[1]); ++y)
-            for (int x = X(b.lo[0]); x < X(b.hi[0]); ++x) {
+        int ua, ub, va, vb;
+        extent(b, ua, ub, va, vb);
+        for (int y = Y(vb); y < Y(va); ++y)
+            for (int x = X(ua); x < X(ub); ++x) {
                 if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
                 uint8_t* p = img.pixel(x, y);
                 p[0] = uint8_t((p[0] + 90) / 3), p[1] = uint8_t(p[1] / 3),
@@ -68,27 +116,33 @@ struct Panel {
     }
 };
 
-Image figure2(const Volume& vol, const GrowingBoxesSource& src, int k, int size) {
+// `k`: the cell layer across ax.s, in index order.
+Image figure2(const Volume& vol, const GrowingBoxesSource& src, const SliceAxes& ax, int k,
+              int size) {
     const Vec3i d = vol.dims();
-    const int cx = d.x - 1, cy = d.y - 1;
-    const int scale = std::max(1, size / std::max(cx, cy));
+    const int cu = d[ax.u] - 1, cv = d[ax.v] - 1;
+    const int scale = std::max(1, size / std::max(cu, cv));
     const int gap = 8;
-    Image img(2 * cx * scale + gap + 1, cy * scale + 1);
+    Image img(2 * cu * scale + gap + 1, cv * scale + 1);
     for (size_t i = 0; i < img.rgba.size(); i += 4)
         img.rgba[i] = img.rgba[i + 1] = img.rgba[i + 2] = 0, img.rgba[i + 3] = 255;
     const ValueRange vis = vol.vis_range();
-    const Panel left{img, 0, scale, cy}, right{img, cx * scale + gap, scale, cy};
-    // The voxel slice z = k in grey (the visualization range), nearest voxel per pixel.
+    const Panel left{img, 0, scale, cu, cv, ax}, right{img, cu * scale + gap, scale, cu, cv, ax};
+    // The voxel plane on the layer's inferior side in grey (the visualization range), nearest
+    // voxel per pixel: index plane k, or k + 1 when the axis runs downward.
     for (const Panel* p : {&left, &right})
-        for (int y = 0; y < cy * scale; ++y)
-            for (int x = 0; x < cx * scale; ++x) {
-                const int vi = std::min(d.x - 1, (x + scale / 2) / scale);
-                const int vj = std::min(d.y - 1, cy - (y + scale / 2) / scale);
-                const float t = (vol.value(vi, vj, k) - vis.min) / std::max(vis.width(), 1e-30f);
+        for (int y = 0; y < cv * scale; ++y)
+            for (int x = 0; x < cu * scale; ++x) {
+                int idx[3];
+                idx[ax.s] = ax.flip_s ? k + 1 : k;
+                idx[ax.u] = p->su(std::min(cu, (x + scale / 2) / scale));
+                idx[ax.v] = p->sv(cv - (y + scale / 2) / scale);
+                const float t =
+                    (vol.value(idx[0], idx[1], idx[2]) - vis.min) / std::max(vis.width(), 1e-30f);
                 const uint8_t g = uint8_t(std::clamp(t, 0.f, 1.f) * 200.f);
                 p->px(p->x0 + x, y, Rgb{g, g, g});
             }
-    auto crosses = [&](const CellBox& b) { return b.lo[2] <= k && k < b.hi[2]; };
+    auto crosses = [&](const CellBox& b) { return b.lo[ax.s] <= k && k < b.hi[ax.s]; };
     // (a) the grown boxes.
     for (const BoxInfo& b : src.grown())
         if (crosses(b.box)) left.rect(b.box, kTypeColour[int(b.type)]);
@@ -116,10 +170,15 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
     validate(a.options);
     if (a.repeat < 1 || a.repeat > 1000) throw Error("--repeat", "repeat", "expected 1..1000");
     const Vec3i d = vol.dims();
-    const int k = a.slice < 0 ? (d.z - 1) / 2 : a.slice;
-    if (k >= d.z - 1)
+    // --slice counts axial cell layers from the inferior end (the same anatomy in any voxel
+    // order); k is the layer in index order.
+    const SliceAxes ax = slice_axes(vol);
+    const int layers = d[ax.s] - 1;
+    const int slice = a.slice < 0 ? layers / 2 : a.slice;
+    if (slice >= layers)
         throw Error("--slice", "cell layer",
-                    "expected 0.." + std::to_string(d.z - 2) + ", got " + std::to_string(k));
+                    "expected 0.." + std::to_string(layers - 1) + ", got " + std::to_string(slice));
+    const int k = ax.flip_s ? layers - 1 - slice : slice;
     const TransferFunction tf = resolve_transfer_function(a.tf);
     const TransferLut lut = discretise(tf, vol.vis_range());
 
@@ -248,12 +307,13 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
         std::printf("wrote %s\n", a.json.c_str());
     }
     if (!a.out.empty()) {
-        const Image img = figure2(vol, *src, k, a.size);
+        const Image img = figure2(vol, *src, ax, k, a.size);
         write_png(a.out, img);
         std::printf(
-            "wrote %s (%dx%d, slice z %d: grown boxes left, BSP leaves right; red "
-            "uniform, blue gradient, green other; tinted violet: empty under the TF)\n",
-            a.out.c_str(), img.width, img.height, k);
+            "wrote %s (%dx%d, axial slice %d from inferior = index %c %d, seen from above, "
+            "patient's right to the right: grown boxes left, BSP leaves right; red uniform, blue "
+            "gradient, green other; tinted violet: empty under the TF)\n",
+            a.out.c_str(), img.width, img.height, slice, "xyz"[ax.s], k);
     }
 }
 
