@@ -22,6 +22,7 @@ BrickGrid::BrickGrid(const Volume& v, const AccelOptions& o) : OctreeBase(AccelK
 
 void BrickGrid::build() {
     const auto t0 = std::chrono::steady_clock::now();
+    m_fine_lo.clear(), m_fine_hi.clear();  // made again, with this map, on the next refine()
     std::vector<uint16_t> lo, hi;
     apron_brick_ranges(m_volume, m_map, 1 << m_log2, m_opts.threads, lo, hi);
     const size_t words = size_t(m_nw[0]) * m_nw[1] * m_nw[2];
@@ -108,20 +109,23 @@ void BrickGrid::build_nearest_bins() {
     });
 }
 
-// Chebyshev distance transform of the block grid, separable: per x row the distance to the
-// nearest occupied block (two sweeps), then along y and z the min over q of max(|i - q|, f(q))
-// (brute force per line: a block grid has tens of blocks per axis). Capped at 255, which only
-// shrinks leaps. An all-empty grid gets 255 everywhere.
-void BrickGrid::compute_distances() {
-    const int nx = m_nw[0], ny = m_nw[1], nz = m_nw[2];
-    constexpr int kCap = 255;
-    std::vector<int> f(m_words.size());
+// Chebyshev distance transform of an n[0] x n[1] x n[2] grid (x fastest), separable: per x row
+// the distance to the nearest occupied entry (two sweeps), then along y and z the min over q of
+// max(|i - q|, f(q)) (brute force per line, outward from i until the distance cannot improve).
+// f[i] is 0 where occupied(i); capped at kCap, which only shrinks leaps (a grid with nothing
+// occupied gets kCap everywhere).
+namespace {
+constexpr int kCap = 255;
+template <class Occupied>
+std::vector<int> chebyshev_distances(const int n[3], Occupied&& occupied) {
+    const int nx = n[0], ny = n[1], nz = n[2];
+    std::vector<int> f(size_t(nx) * ny * nz);
     auto at = [&](int x, int y, int z) -> int& { return f[(size_t(z) * ny + y) * nx + x]; };
     for (int z = 0; z < nz; ++z)
         for (int y = 0; y < ny; ++y) {
             int d = kCap;
             for (int x = 0; x < nx; ++x) {
-                d = m_words[(size_t(z) * ny + y) * nx + x] ? 0 : std::min(kCap, d + 1);
+                d = occupied((size_t(z) * ny + y) * nx + x) ? 0 : std::min(kCap, d + 1);
                 at(x, y, z) = d;
             }
             d = kCap;
@@ -131,26 +135,32 @@ void BrickGrid::compute_distances() {
             }
         }
     std::vector<int> line, out;
-    auto pass = [&](int n, auto&& cell) {
-        line.resize(size_t(n));
-        out.resize(size_t(n));
-        for (int i = 0; i < n; ++i) line[size_t(i)] = cell(i);
-        for (int i = 0; i < n; ++i) {
-            // Outward from i: a q at distance >= best cannot improve on best.
+    auto pass = [&](int len, auto&& cell) {
+        line.resize(size_t(len));
+        out.resize(size_t(len));
+        for (int i = 0; i < len; ++i) line[size_t(i)] = cell(i);
+        for (int i = 0; i < len; ++i) {
             int best = line[size_t(i)];
             for (int d = 1; d < best; ++d) {
                 if (i - d >= 0) best = std::min(best, std::max(d, line[size_t(i - d)]));
-                if (i + d < n) best = std::min(best, std::max(d, line[size_t(i + d)]));
-                if (i - d < 0 && i + d >= n) break;
+                if (i + d < len) best = std::min(best, std::max(d, line[size_t(i + d)]));
+                if (i - d < 0 && i + d >= len) break;
             }
             out[size_t(i)] = best;
         }
-        for (int i = 0; i < n; ++i) cell(i) = out[size_t(i)];
+        for (int i = 0; i < len; ++i) cell(i) = out[size_t(i)];
     };
     for (int z = 0; z < nz; ++z)
         for (int x = 0; x < nx; ++x) pass(ny, [&](int y) -> int& { return at(x, y, z); });
     for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) pass(nz, [&](int z) -> int& { return at(x, y, z); });
+    return f;
+}
+}  // namespace
+
+// The block grid's distances (the DDA's leaps out of empty blocks), at least 1.
+void BrickGrid::compute_distances() {
+    const std::vector<int> f = chebyshev_distances(m_nw, [&](size_t i) { return m_words[i] != 0; });
     for (size_t i = 0; i < f.size(); ++i) m_dist[i] = uint8_t(std::clamp(f[i], 1, kCap));
 }
 
@@ -176,6 +186,17 @@ void BrickGrid::refine() {
                       },
                       m_opts.threads, m_mask);
     m_mask_ready = true;
+    // The leap map: fine bricks' apron ranges (TF-independent, made on the first refine), their
+    // occupancy under this TF, and its Chebyshev distances.
+    if (m_fine_lo.empty()) {
+        apron_brick_ranges(m_volume, m_map, 1 << kLeapLog2, m_opts.threads, m_fine_lo, m_fine_hi);
+        for (int a = 0; a < 3; ++a) m_nf[a] = (m_pyr.cells[a] + (1 << kLeapLog2) - 1) >> kLeapLog2;
+    }
+    const uint16_t* next = m_next_visible.data();
+    const std::vector<int> f = chebyshev_distances(
+        m_nf, [&](size_t i) { return next[m_fine_lo[i]] <= m_fine_hi[i]; });
+    m_leap.assign(f.size() + 3, 0);  // padding: kernels read 32-bit words
+    for (size_t i = 0; i < f.size(); ++i) m_leap[i] = uint8_t(f[i]);
     m_stats.refine_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -18,6 +18,14 @@
 // shared header can be emitted with AVX2 code and picked by the linker for everyone); they run
 // only after a CPUID check. No lambdas inside them (a lambda does not inherit the target).
 //
+// Leaping (kLeap, the refined grid; the scheduler then hands each lane its whole ray as one run).
+// Each lane looks up the leap map at its sample's position p (the fine brick of p's trilinear
+// cell, 4^3 cells): distance d = 0, the sample is composited as always; d >= 1, it and the next
+// s - 1 samples are skipped, s = floor((d - 1) * 4 / (dt * max|dir|)) + 1, so every skipped
+// sample lies within (d - 1) * 4 cells (L-infinity) of p, in fine bricks that are all empty (see
+// BrickGrid::leap_map); the next sample taken is the lattice's k + s. The walk and its runs are
+// gone: one leap per look-up, in the lanes.
+//
 // State lives in arrays (the scheduler in render/ray_marcher.cpp reads and refills single lanes)
 // and in registers while a kernel runs. A lane is valid while k < kend; an invalid lane
 // composites the all-zero LUT entry `zero_entry` (C + w * 0 = C exactly), so it changes nothing
@@ -69,6 +77,10 @@ struct LaneGrid {
     float lut_offset, lut_scale, lut_last;
     int32_t zero_entry;
     float ert;
+    // Leaping (kernels with kLeap): the grid's leap map (accel/brick_grid.h leap_map) and its
+    // strides in fine bricks.
+    const uint8_t* leap = nullptr;
+    int32_t leap_sy = 0, leap_sz = 0;
 };
 
 // Eight camera rays at once, for the scheduler's ray set-up: Camera::generate, the move into
@@ -617,9 +629,10 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
     return _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
 }
 
-template <bool kNearest, class T, class Refill>
+template <bool kNearest, class T, class Refill, bool kLeap = false>
 LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                                 Refill& refill) {
+    static_assert(!(kLeap && kNearest), "leaping is for trilinear samples");
     const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
     const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
     const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
@@ -640,7 +653,12 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     k = _mm512_load_si512(s.k);                                                             \
     n = _mm512_load_si512(s.n);                                                             \
     ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b);           \
-    aa = _mm512_load_ps(s.a);
+    aa = _mm512_load_ps(s.a);                                                               \
+    if constexpr (kLeap)                                                                    \
+        lscale = _mm512_div_ps(_mm512_set1_ps(4.f),                                         \
+                               _mm512_mul_ps(vdt, _mm512_max_ps(_mm512_abs_ps(dx),         \
+                                             _mm512_max_ps(_mm512_abs_ps(dy), _mm512_abs_ps(dz)))));
+    __m512 lscale = _mm512_setzero_ps();  // leaping: 4 / (dt * max|dir|), per lane
     int waiting = 0;
     LACUNA_LOAD_LANES
     int need;
@@ -674,9 +692,32 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         } else {
             v = trilinear16(g, data, x, y, z, active);
         }
+        // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead.
+        __mmask16 taken = valid;
+        __m512i adv = ione;
+        if constexpr (kLeap) {
+            const __m512i fi = _mm512_srli_epi32(_mm512_min_epi32(_mm512_cvttps_epi32(x), _mm512_set1_epi32(g.cell[0])), 2);
+            const __m512i fj = _mm512_srli_epi32(_mm512_min_epi32(_mm512_cvttps_epi32(y), _mm512_set1_epi32(g.cell[1])), 2);
+            const __m512i fk = _mm512_srli_epi32(_mm512_min_epi32(_mm512_cvttps_epi32(z), _mm512_set1_epi32(g.cell[2])), 2);
+            const __m512i idx = _mm512_add_epi32(
+                _mm512_add_epi32(_mm512_mullo_epi32(fk, _mm512_set1_epi32(g.leap_sz)),
+                                 _mm512_mullo_epi32(fj, _mm512_set1_epi32(g.leap_sy))),
+                fi);
+            const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 1);
+            const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
+            const __mmask16 skip = _mm512_mask_test_epi32_mask(valid, d, d);
+            taken = valid & ~skip;
+            // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
+            const __m512i leap = _mm512_add_epi32(
+                _mm512_cvttps_epi32(_mm512_min_ps(
+                    _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_sub_epi32(d, ione)), lscale),
+                    _mm512_set1_ps(16777216.f))),
+                ione);
+            adv = _mm512_mask_blend_epi32(skip, ione, leap);
+        }
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
         u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
-        const __m512i entry = _mm512_mask_blend_epi32(valid, vzero_entry, _mm512_cvttps_epi32(u));
+        const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
         // RGBA of the 16 entries: sixteen 16-byte loads and a 4x4 transpose per 128-bit lane
         // (gathers cost ~1.4 cycles per element here; this is ~1.5 shuffles per sample). Lane j
         // of q4[i] holds lane 4j + i's entry, so the transpose leaves the channels in lane order.
@@ -700,8 +741,11 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         ag = _mm512_add_ps(ag, _mm512_mul_ps(w, cg));
         ab = _mm512_add_ps(ab, _mm512_mul_ps(w, cb));
         aa = _mm512_add_ps(aa, _mm512_mul_ps(w, ca));
-        n = _mm512_mask_add_epi32(n, valid, n, ione);
-        k = _mm512_mask_add_epi32(k, valid, k, ione);
+        n = _mm512_mask_add_epi32(n, taken, n, ione);
+        if constexpr (kLeap)
+            k = _mm512_min_epi32(_mm512_mask_add_epi32(k, valid, k, adv), kend);
+        else
+            k = _mm512_mask_add_epi32(k, valid, k, ione);
         const __mmask16 over =
             _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, vert, _CMP_GE_OS);
         // Waiting lanes, as in the AVX2 kernel: refill once a quarter of the lanes wait.

@@ -6,6 +6,8 @@
 #include <optional>
 
 #include "accel/accel_impl.h"
+#include "accel/brick_grid.h"
+#include "accel/no_accel.h"
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
 #include "lacuna/error.h"
@@ -135,7 +137,8 @@ template <int W, class T, class S, class March>
 void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const Camera& cam,
                        const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
                        int x0, int y0, int x1, int y1, RenderResult& out,
-                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March&& march) {
+                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March&& march,
+                       const BrickGrid* leap = nullptr) {
     using Cursor = typename S::Cursor;
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
     const Vec3f inv_sp = inverse_spacing(vol);
@@ -151,7 +154,10 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
                             map.scale(),
                             float(map.last()),
                             int32_t(lut.size() - 1),  // the zero entry render() appends
-                            opt.ert};
+                            opt.ert,
+                            leap ? leap->leap_map() : nullptr,
+                            leap ? leap->leap_dims()[0] : 0,
+                            leap ? leap->leap_dims()[0] * leap->leap_dims()[1] : 0};
     struct Slot {
         int x = 0, y = 0;
         std::optional<Cursor> cursor;
@@ -269,6 +275,22 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                                 samples, rays);
         return;
     }
+#if LACUNA_SIMD_X86
+    // The refined grid on AVX-512: every ray one run, leaping in the lanes (core/simd_lanes.h).
+    if constexpr (std::is_same_v<S, BrickGrid> && !kNearest) {
+        if (isa == simd::Isa::Avx512 && accel.leap_map()) {
+            static const NoAccel kWholeRay;
+            render_tile_lanes<16>(
+                kWholeRay, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
+                [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l, auto& refill) {
+                    simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true>(
+                        L, lg, d, l, refill);
+                },
+                &accel);
+            return;
+        }
+    }
+#endif
     switch (isa) {
 #if LACUNA_SIMD_X86
         case simd::Isa::Avx512:
