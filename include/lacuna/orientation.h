@@ -46,7 +46,11 @@ Box3f world_bounds(const Volume& v);
 
 // Throws lacuna::Error(where, field, ...) unless spacing is finite and positive, origin finite,
 // and direction finite with orthonormal columns within 1e-4 (a rotation, possibly with a flip):
-// a zero, singular, non-finite or sheared geometry is refused, naming the field.
+// a zero, singular, non-finite or sheared geometry is refused, naming the field. Also refused,
+// as the renderers' float positions cannot hold it (a picture would come out empty): spacing
+// below 1e-15 mm, a volume more than 1e15 mm across or with a corner beyond 1e15 mm ("spacing",
+// "origin"), and one further from the world origin than both twice its size and 2^19 of its
+// finest spacing ("origin").
 void check_geometry(const Volume& v, const std::string& where);
 
 // The rigid map from world (RAS) to the volume frame: q = rot * (p - from). `identity` when it

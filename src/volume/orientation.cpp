@@ -119,6 +119,40 @@ void check_geometry(const Volume& v, const std::string& where) {
                     "axes " + std::to_string(a) + " and " + std::to_string(b) +
                         " are not perpendicular (cos " + num(col_dot(a, b)) +
                         "): a sheared or singular grid, which lacuna does not render: " + dir);
+    // Renderable in float: the camera, the world bounds and the volume frame are float. Measured
+    // on an 8^3 file (docs/reliability.md), pictures are the bytes of spacing 1 for any spacing
+    // from 1e-20 to 1e18 mm and empty (0 samples per ray, no error) below 1e-40 or above 1e19,
+    // where squared lengths leave float: so spacing and every world coordinate stay within
+    // 1e-15 .. 1e15 mm. Far from the world origin, float resolves positions only to |x| * 2^-24,
+    // which the camera's eye adds to the rounding of the volume's own size: a volume further
+    // out than twice its size and 2^19 of its finest spacing (a 32nd of a voxel) is refused
+    // (spacing 1 at 1e5 mm renders within 1 of 255 per channel; at 1e6 mm up to 32 off; at
+    // 1e9 mm nothing).
+    const Vec3i d = v.dims();
+    const double finest = std::fmin(v.spacing.x, std::fmin(v.spacing.y, v.spacing.z));
+    if (!(finest >= 1e-15))
+        throw Error(where, "spacing",
+                    "voxel spacing " + num(finest) +
+                        " mm is below 1e-15 mm, too fine for the float positions of the renderers");
+    double size = 0;  // the largest side of the voxel box, mm
+    for (int a = 0; a < 3; ++a) size = std::fmax(size, double(d[a]) * v.spacing[a]);
+    if (!(size <= 1e15))
+        throw Error(where, "spacing",
+                    "the volume spans " + num(size) +
+                        " mm, more than the 1e15 mm the float positions of the renderers reach");
+    const Affine w = index_to_world(v);
+    double far = 0;  // the largest world coordinate of a corner, mm
+    for (int c = 0; c < 8; ++c) {
+        const Vec3d p = w.apply({c & 1 ? double(d.x - 1) : 0.0, c & 2 ? double(d.y - 1) : 0.0,
+                                 c & 4 ? double(d.z - 1) : 0.0});
+        far = std::fmax(far, std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z))));
+    }
+    if (!(far <= 1e15) || (far > 2 * size && far > 0x1p19 * finest))
+        throw Error(where, "origin",
+                    "the volume (" + num(size) + " mm across, voxels of " + num(finest) +
+                        " mm) lies " + num(far) +
+                        " mm from the world origin, too far for float positions to resolve its "
+                        "voxels (at most 2^19 voxels or twice its size, and 1e15 mm)");
 }
 
 Vec3f VolumeFrame::point(Vec3f p) const {

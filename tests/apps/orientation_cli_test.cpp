@@ -105,6 +105,44 @@ TEST(OrientationCli, BadAffinesAreOneLineNamingTheFileAndFieldAndWriteNothing) {
     }
 }
 
+// A NIfTI whose geometry float cannot resolve (pixdim 1e-40 or 1e20, qoffset 1e9 with 1 mm
+// voxels, an sform translation of 1e16) used to render an empty picture and exit 0.
+TEST(OrientationCli, GeometryFloatCannotResolveIsAnErrorNotAnEmptyPicture) {
+    lacuna::test::NiftiSpec tiny;
+    tiny.pixdim = {1e-40, 1e-40, 1e-40};
+    lacuna::test::NiftiSpec huge;
+    huge.pixdim = {1e20, 1e20, 1e20};
+    lacuna::test::NiftiSpec far;
+    far.qform_code = 1;
+    far.qoffset = {1e9, 0, 0};
+    const struct {
+        const char* name;
+        lacuna::test::NiftiSpec spec;
+        const char* field;
+    } cases[] = {
+        {"tiny-pixdim.nii", tiny, "spacing"},
+        {"huge-pixdim.nii", huge, "spacing"},
+        {"far-qoffset.nii", far, "origin"},
+        {"far-sform.nii", sform({{{1, 0, 0, 0}, {0, 1, 0, 1e16}, {0, 0, 1, 0}}}), "origin"},
+    };
+    for (const auto& c : cases) {
+        const fs::path f = nifti(c.name, c.spec);
+        const fs::path png = temp_dir() / (std::string(c.name) + ".png");
+        const CliResult r =
+            run("render " + f.string() + " --tf mr-default --size 16 --out " + png.string());
+        expect_one_line_error(r, f.string() + ": " + c.field + ":");
+        EXPECT_FALSE(fs::exists(png)) << c.name;
+    }
+    // Within the limits: rendered.
+    lacuna::test::NiftiSpec near = far;
+    near.qoffset = {1e4, 0, 0};
+    const fs::path png = temp_dir() / "near-qoffset.png";
+    const CliResult r = run("render " + nifti("near-qoffset.nii", near).string() +
+                            " --tf mr-default --size 16 --out " + png.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(png));
+}
+
 TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng) {
     // One anatomy twice: RAS storage, and the same voxels mirrored in i and j stored as LPS.
     lacuna::test::NiftiSpec ras = sform({{{1, 0, 0, -2.5}, {0, 1, 0, -3}, {0, 0, 1, -3.5}}});

@@ -122,5 +122,49 @@ TEST(Orientation, ZeroSingularNonFiniteOrShearedGeometryIsRefusedNamingTheField)
     expect_error(sp, "spacing");
 }
 
+// Geometry the renderers' float positions cannot hold rendered an empty picture without a word
+// (0 samples per ray): refused, naming the field; just inside the limits is accepted.
+TEST(Orientation, GeometryFloatCannotResolveIsRefusedNamingTheField) {
+    auto error_field = [](const Volume& v) -> std::string {
+        try {
+            check_geometry(v, "f.nii");
+            return "";
+        } catch (const Error& e) {
+            const std::string m = e.what();
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+            return m.substr(0, m.find(':', 7));  // "f.nii: <field>"
+        }
+    };
+    const Volume v({8, 8, 8}, VoxelType::UInt8);
+    auto with = [&](Vec3d spacing, Vec3d origin) {
+        Volume w = v;
+        w.spacing = spacing;
+        w.origin = origin;
+        return error_field(w);
+    };
+    EXPECT_EQ(with({1e-20, 1e-20, 1e-20}, {0, 0, 0}), "f.nii: spacing");
+    EXPECT_EQ(with({1, 1e-16, 1}, {0, 0, 0}), "f.nii: spacing");
+    EXPECT_EQ(with({1e-15, 1e-15, 1e-15}, {0, 0, 0}), "");
+    EXPECT_EQ(with({2e14, 1, 1}, {0, 0, 0}), "f.nii: spacing");  // 1.6e15 mm across
+    EXPECT_EQ(with({1e14, 1, 1}, {0, 0, 0}), "");
+    EXPECT_EQ(with({1, 1, 1}, {0, 0, 2e15}), "f.nii: origin");
+    // Far out compared with the finest voxel (2^19 = 524288) and twice the volume's size.
+    EXPECT_EQ(with({1, 1, 1}, {1e6, 0, 0}), "f.nii: origin");
+    EXPECT_EQ(with({1, 1, 1}, {0, -5e5, 0}), "");
+    EXPECT_EQ(with({1e-3, 1e-3, 1e-3}, {0, 0, 600}), "f.nii: origin");
+    EXPECT_EQ(with({1e-3, 1e-3, 1e-3}, {0, 0, 500}), "");
+    // A volume whose long side is far in voxels of its short one is not refused for its own
+    // size (its volume frame rounds as much): the twice-its-size clause.
+    Volume longv({2, 2, 32768}, VoxelType::UInt8);
+    longv.spacing = {1e-3, 1e-3, 1};
+    EXPECT_EQ(error_field(longv), "");
+    longv.origin = {0, 0, 70000};  // now far beyond twice its size too
+    EXPECT_EQ(error_field(longv), "f.nii: origin");
+    Volume aniso({1000, 1000, 2}, VoxelType::UInt8);
+    aniso.spacing = {1, 1, 1e-4};
+    aniso.origin = {-500, -500, 0};
+    EXPECT_EQ(error_field(aniso), "");
+}
+
 }  // namespace
 }  // namespace lacuna
