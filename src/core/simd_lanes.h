@@ -433,9 +433,10 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, co
     }
 }
 
-template <bool kNearest, class T, class Refill>
+template <bool kNearest, class T, class Refill, bool kLeap = false>
 LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                               Refill& refill) {
+    static_assert(!(kLeap && kNearest), "leaping is for trilinear samples");
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.f);
     const __m256 vdt = _mm256_set1_ps(g.dt), vert = _mm256_set1_ps(g.ert);
     const __m256 voff = _mm256_set1_ps(g.lut_offset), vscale = _mm256_set1_ps(g.lut_scale),
@@ -453,7 +454,14 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
     n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
     ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);     \
     aa = _mm256_load_ps(s.a);                                                         \
-    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));
+    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
+    if constexpr (kLeap)                                                              \
+        lscale = _mm256_div_ps(_mm256_set1_ps(4.f),                                   \
+                               _mm256_mul_ps(vdt, _mm256_max_ps(_mm256_andnot_ps(sign, dx),      \
+                                             _mm256_max_ps(_mm256_andnot_ps(sign, dy),          \
+                                                           _mm256_andnot_ps(sign, dz)))));
+    const __m256 sign = _mm256_set1_ps(-0.f);
+    __m256 lscale = _mm256_setzero_ps();  // leaping: 4 / (dt * max|dir|), per lane
     int active_mask, waiting = 0;
     LACUNA_LOAD_LANES
     int need;
@@ -469,9 +477,37 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
             v = nearest8(g, data, x, y, z);
         else
             v = trilinear8(g, data, x, y, z);
+        // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead.
+        __m256i taken = valid, adv = _mm256_set1_epi32(1);
+        if constexpr (kLeap) {
+            const __m256 p[3] = {x, y, z};
+            __m256i f[3];
+            for (int a = 0; a < 3; ++a)
+                f[a] = _mm256_srli_epi32(
+                    _mm256_min_epi32(_mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[a]), p[a]))),
+                                     _mm256_set1_epi32(g.cell[a])),
+                    2);
+            const __m256i idx = _mm256_add_epi32(
+                _mm256_add_epi32(_mm256_mullo_epi32(f[2], _mm256_set1_epi32(g.leap_sz)),
+                                 _mm256_mullo_epi32(f[1], _mm256_set1_epi32(g.leap_sy))),
+                f[0]);
+            const __m256i w = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
+                                                          reinterpret_cast<const int*>(g.leap), idx, valid, 1);
+            const __m256i d = _mm256_and_si256(w, _mm256_set1_epi32(0xff));
+            const __m256i skip = _mm256_andnot_si256(_mm256_cmpeq_epi32(d, _mm256_setzero_si256()), valid);
+            taken = _mm256_andnot_si256(skip, valid);
+            const __m256i one_i = _mm256_set1_epi32(1);
+            // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
+            const __m256i leap = _mm256_add_epi32(
+                _mm256_cvttps_epi32(_mm256_min_ps(
+                    _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_sub_epi32(d, one_i)), lscale),
+                    _mm256_set1_ps(16777216.f))),
+                one_i);
+            adv = _mm256_blendv_epi8(one_i, leap, skip);
+        }
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
-        const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), valid);
+        const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), taken);
         // Composite one sample per lane (RGBA gathered from the LUT, SoA).
         // RGBA of the 8 entries: eight 16-byte loads and a 4x4 transpose per 128-bit lane (lane
         // j of q4[i] holds lane 4j + i's entry, so the channels come out in lane order).
@@ -492,8 +528,11 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
         ag = _mm256_add_ps(ag, _mm256_mul_ps(w, cg));
         ab = _mm256_add_ps(ab, _mm256_mul_ps(w, cb));
         aa = _mm256_add_ps(aa, _mm256_mul_ps(w, ca));
-        n = _mm256_sub_epi32(n, valid);
-        k = _mm256_sub_epi32(k, valid);
+        n = _mm256_sub_epi32(n, taken);
+        if constexpr (kLeap)
+            k = _mm256_min_epi32(_mm256_add_epi32(k, _mm256_and_si256(adv, valid)), kend);
+        else
+            k = _mm256_sub_epi32(k, valid);
         const __m256i over = _mm256_or_si256(
             _mm256_cmpeq_epi32(k, kend), _mm256_castps_si256(_mm256_cmp_ps(aa, vert, _CMP_GE_OS)));
         // A lane whose run is over, or which is opaque, waits (kend = k makes it invalid) until

@@ -276,14 +276,25 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
         return;
     }
 #if LACUNA_SIMD_X86
-    // The refined grid on AVX-512: every ray one run, leaping in the lanes (core/simd_lanes.h).
+    // The refined grid on AVX-512 and AVX2: every ray one run, leaping in the lanes
+    // (core/simd_lanes.h).
     if constexpr (std::is_same_v<S, BrickGrid> && !kNearest) {
+        static const NoAccel kWholeRay;
         if (isa == simd::Isa::Avx512 && accel.leap_map()) {
-            static const NoAccel kWholeRay;
             render_tile_lanes<16>(
                 kWholeRay, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
                 [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l, auto& refill) {
                     simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true>(
+                        L, lg, d, l, refill);
+                },
+                &accel);
+            return;
+        }
+        if (isa == simd::Isa::Avx2 && accel.leap_map()) {
+            render_tile_lanes<8>(
+                kWholeRay, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
+                [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l, auto& refill) {
+                    simd::march_lanes8<false, T, std::remove_reference_t<decltype(refill)>, true>(
                         L, lg, d, l, refill);
                 },
                 &accel);

@@ -51,13 +51,17 @@ void expect_all_structures_exact(const Case& c, std::vector<AccelKind> kinds = a
         auto accel = make_accel(k, *c.volume, c.accel);
         accel->set_transfer_function(c.lut);
         // As the TF change leaves the structure, then refined (the grid's cell mask and leap
-        // map; a no-op for the others).
-        for (int refined = 0; refined < 2; ++refined) {
-            if (refined) accel->refine();
+        // map, a no-op for the others) on every kernel path (the leaping kernels are per ISA).
+        const test::KernelPaths kp;
+        for (size_t pass = 0; pass <= kp.paths.size(); ++pass) {
+            const bool refined = pass > 0;
+            if (pass == 1) accel->refine();
+            if (refined) simd::set_isa(kp.paths[pass - 1]);
             m.set_accel(accel.get());
             const RenderResult r = m.render(c.camera, o);
             m.set_accel(nullptr);
-            const std::string what = c.name + " accel " + to_string(k) + (refined ? " refined" : "");
+            const std::string what = c.name + " accel " + to_string(k) +
+                                     (refined ? " refined, path " + simd::to_string(kp.paths[pass - 1]) : "");
             ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
             ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
                                      ref.rgba_float.size() * sizeof(float)))
