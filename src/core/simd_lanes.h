@@ -433,6 +433,38 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, co
     }
 }
 
+// Leaping, eight lanes (see "Leaping" above): for the valid lanes whose sample (x, y, z, not
+// yet clamped) lies in an empty fine brick, taken loses the lane and adv becomes its skip.
+LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, __m256 x, __m256 y,
+                                                        __m256 z, __m256i valid, __m256 lscale,
+                                                        __m256i& taken, __m256i& adv) {
+    const __m256 zero = _mm256_setzero_ps();
+    const __m256 p[3] = {x, y, z};
+    __m256i f[3];
+    for (int a = 0; a < 3; ++a)
+        f[a] = _mm256_srli_epi32(
+            _mm256_min_epi32(_mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[a]), p[a]))),
+                             _mm256_set1_epi32(g.cell[a])),
+            2);
+    const __m256i idx = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_mullo_epi32(f[2], _mm256_set1_epi32(g.leap_sz)),
+                         _mm256_mullo_epi32(f[1], _mm256_set1_epi32(g.leap_sy))),
+        f[0]);
+    const __m256i w = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
+                                                  reinterpret_cast<const int*>(g.leap), idx, valid, 1);
+    const __m256i d = _mm256_and_si256(w, _mm256_set1_epi32(0xff));
+    const __m256i skip = _mm256_andnot_si256(_mm256_cmpeq_epi32(d, _mm256_setzero_si256()), valid);
+    taken = _mm256_andnot_si256(skip, valid);
+    const __m256i one_i = _mm256_set1_epi32(1);
+    // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
+    const __m256i leap = _mm256_add_epi32(
+        _mm256_cvttps_epi32(_mm256_min_ps(
+            _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_sub_epi32(d, one_i)), lscale),
+            _mm256_set1_ps(16777216.f))),
+        one_i);
+    adv = _mm256_blendv_epi8(one_i, leap, skip);
+}
+
 template <bool kNearest, class T, class Refill, bool kLeap = false>
 LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                               Refill& refill) {
@@ -479,32 +511,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
             v = trilinear8(g, data, x, y, z);
         // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead.
         __m256i taken = valid, adv = _mm256_set1_epi32(1);
-        if constexpr (kLeap) {
-            const __m256 p[3] = {x, y, z};
-            __m256i f[3];
-            for (int a = 0; a < 3; ++a)
-                f[a] = _mm256_srli_epi32(
-                    _mm256_min_epi32(_mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[a]), p[a]))),
-                                     _mm256_set1_epi32(g.cell[a])),
-                    2);
-            const __m256i idx = _mm256_add_epi32(
-                _mm256_add_epi32(_mm256_mullo_epi32(f[2], _mm256_set1_epi32(g.leap_sz)),
-                                 _mm256_mullo_epi32(f[1], _mm256_set1_epi32(g.leap_sy))),
-                f[0]);
-            const __m256i w = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
-                                                          reinterpret_cast<const int*>(g.leap), idx, valid, 1);
-            const __m256i d = _mm256_and_si256(w, _mm256_set1_epi32(0xff));
-            const __m256i skip = _mm256_andnot_si256(_mm256_cmpeq_epi32(d, _mm256_setzero_si256()), valid);
-            taken = _mm256_andnot_si256(skip, valid);
-            const __m256i one_i = _mm256_set1_epi32(1);
-            // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
-            const __m256i leap = _mm256_add_epi32(
-                _mm256_cvttps_epi32(_mm256_min_ps(
-                    _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_sub_epi32(d, one_i)), lscale),
-                    _mm256_set1_ps(16777216.f))),
-                one_i);
-            adv = _mm256_blendv_epi8(one_i, leap, skip);
-        }
+        if constexpr (kLeap) leap8(g, x, y, z, valid, lscale, taken, adv);
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
         const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), taken);

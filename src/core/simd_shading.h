@@ -362,10 +362,22 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 dot8(__m256 ax, __m256 
                                        _mm256_mul_ps(ay, _mm256_set1_ps(b[1]))),
                          _mm256_mul_ps(az, _mm256_set1_ps(b[2])));
 }
+// A direction per lane (SoA), or one for every lane (broadcast).
+struct Dir8 {
+    __m256 x, y, z;
+};
+LACUNA_AVX2 inline __attribute__((always_inline)) Dir8 dir8(const float* d) {
+    return {_mm256_set1_ps(d[0]), _mm256_set1_ps(d[1]), _mm256_set1_ps(d[2])};
+}
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 dot8(__m256 ax, __m256 ay, __m256 az,
+                                                             const Dir8& b) {
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ax, b.x), _mm256_mul_ps(ay, b.y)),
+                         _mm256_mul_ps(az, b.z));
+}
 
-// The normals of normal_from_gradient; the mask of lanes with a non-zero gradient.
+// The normals of normal_from_gradient, facing v; the mask of lanes with a non-zero gradient.
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256 normals8(const float* gx, const float* gy,
-                                                                 const float* gz, const float* v,
+                                                                 const float* gz, const Dir8& v,
                                                                  __m256& nx, __m256& ny,
                                                                  __m256& nz) {
     const __m256 x = _mm256_loadu_ps(gx), y = _mm256_loadu_ps(gy), z = _mm256_loadu_ps(gz);
@@ -392,18 +404,19 @@ LACUNA_AVX2 inline __m256 spec_pow8(__m256 x, int power) {
     }
 }
 
-// r, g, b in place: the shaded colours of lanes < n.
-LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const float* gx,
-                               const float* gy, const float* gz, float* r, float* g, float* b,
-                               int n) {
+// phong_h per lane: light l, view v and half vector h per lane, h_ok the lanes whose |l + v| > 0,
+// intensity li for all; r, g, b in place (lanes < n get the specular power).
+LACUNA_AVX2 inline void phong8(const PhongLanes& p, float li, const Dir8& l, const Dir8& v,
+                               const Dir8& h, __m256 h_ok, const float* gx, const float* gy,
+                               const float* gz, float* r, float* g, float* b, int n) {
     const __m256 zero = _mm256_setzero_ps();
     __m256 nx, ny, nz;
-    const __m256 ok = normals8(gx, gy, gz, L.v, nx, ny, nz);
-    const __m256 ndl = _mm256_max_ps(zero, dot8(nx, ny, nz, L.l));
+    const __m256 ok = normals8(gx, gy, gz, v, nx, ny, nz);
+    const __m256 ndl = _mm256_max_ps(zero, dot8(nx, ny, nz, l));
     alignas(32) float spec[8] = {};
-    if (L.h_ok) {
-        const __m256 vndh = _mm256_max_ps(zero, dot8(nx, ny, nz, L.h));
-        const __m256 vlit = _mm256_and_ps(ok, _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ));
+    if (_mm256_movemask_ps(h_ok)) {
+        const __m256 vndh = _mm256_max_ps(zero, dot8(nx, ny, nz, h));
+        const __m256 vlit = _mm256_and_ps(_mm256_and_ps(ok, h_ok), _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ));
         if (integer_power(p.power)) {
             _mm256_store_ps(spec, _mm256_and_ps(vlit, spec_pow8(vndh, int(p.power))));
         } else {
@@ -414,7 +427,7 @@ LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const f
                 if (lit[j] != 0.f) spec[j] = std::pow(ndh[j], p.power);
         }
     }
-    const __m256 vli = _mm256_set1_ps(L.li);
+    const __m256 vli = _mm256_set1_ps(li);
     const __m256 k = _mm256_add_ps(_mm256_set1_ps(p.ambient),
                                    _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.diffuse), vli), ndl));
     const __m256 sp = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.specular), vli), _mm256_load_ps(spec));
@@ -425,12 +438,20 @@ LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const f
     }
 }
 
+// The same for one light and view for all lanes (one ray's samples).
+LACUNA_AVX2 inline void phong8(const PhongLanes& p, const ShadeLight& L, const float* gx,
+                               const float* gy, const float* gz, float* r, float* g, float* b,
+                               int n) {
+    const __m256 h_ok = L.h_ok ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : _mm256_setzero_ps();
+    phong8(p, L.li, dir8(L.l), dir8(L.v), dir8(L.h), h_ok, gx, gy, gz, r, g, b, n);
+}
+
 // pbr_h for a fixed half vector (callers fall back to the scalar pbr() when !L.h_ok).
 LACUNA_AVX2 inline void pbr8(const PbrLanes& p, const ShadeLight& L, const float* gx,
                              const float* gy, const float* gz, float* r, float* g, float* b) {
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.f);
     __m256 nx, ny, nz;
-    const __m256 ok = normals8(gx, gy, gz, L.v, nx, ny, nz);
+    const __m256 ok = normals8(gx, gy, gz, dir8(L.v), nx, ny, nz);
     // Per-ray scalars, as pbr_h and its helpers compute them.
     const float rough = std::clamp(p.roughness, 0.02f, 1.f);
     const float alpha = rough * rough;
@@ -527,6 +548,184 @@ LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data
     return int(_mm512_cmp_ps_mask(a, zero, _CMP_GT_OQ));
 }
 #pragma GCC diagnostic pop
+
+// ---- Shading across rays (AVX2): the shaded lane kernel ---------------------------------
+// march_shaded_lanes8 is march_lanes8 (core/simd_lanes.h) for Phong-shaded composite rays with
+// a head or directional light, one TF, no clipping, trilinear samples (the render side chooses
+// it: src/render/feature_render.cpp). ShadedStream (src/render/feature_kernel.h) shades one ray
+// at a time: a ray keeps ~25 samples, of which ~4 are visible, so its lattice and its gradient
+// batches run mostly empty lanes. Here lanes are rays, as in the unshaded kernel, and the
+// visible samples of all lanes go to one queue, shaded eight at a time whoever they belong to.
+//
+// Bit-exactness. Per lane, the lattice positions, values and LUT entries are march_lanes8's
+// (ShadedStream's, operation for operation), and the opacity chain w = 1 - A, A += w * a runs on
+// every sample: a sample with a = 0 adds exactly +0 and keeps w, as ShadedStream, which skips it.
+// ShadedStream pushes the samples whose TF opacity is > 0; here those whose step-corrected
+// opacity a is > 0: a sample with TF opacity > 0 and a = 0 would add w * rgb * 0 = +0 to
+// colours that are >= 0, so the bits agree. A queued sample keeps its ray's w and a, its ray
+// (the record) and its position; shading is phong8 with that ray's l, v and h (the ones
+// ShadedStream computes once per ray), and its colour goes into its ray's record by
+// r += w * rgb * a in queue order, which is the ray's sample order. So every pixel has the bits
+// of ShadedStream's, hence of composite_ray's.
+inline constexpr int kShadeRecords = 32;  // rays in flight: the lanes plus the deferred pixels
+// Per ray: colour accumulators, the ray's fixed light (l, v, half vector h, |l + v| > 0), and
+// how many of its samples wait in the queue.
+struct ShadeRecords {
+    alignas(32) float r[kShadeRecords], g[kShadeRecords], b[kShadeRecords];
+    alignas(32) float l[3][kShadeRecords], v[3][kShadeRecords], h[3][kShadeRecords];
+    alignas(32) int32_t h_ok[kShadeRecords];
+    alignas(32) int32_t pending[kShadeRecords];
+};
+// The visible samples waiting for shading, in the order they were composited.
+struct ShadeQueue {
+    alignas(32) float x[16], y[16], z[16], w[16], a[16];
+    alignas(32) int32_t e[16], rec[16];
+    int n = 0;
+};
+// What shading needs besides the samples: the grid, the straight-colour LUT (RGBA floats), the
+// gradient volume (null: central differences), Phong and the light's intensity.
+struct ShadeFrame {
+    ShadeGrid g;
+    const float* raw;
+    const float* const* grad;
+    PhongLanes phong;
+    float li;
+};
+
+// The directions d[.][rec[l]] of eight records.
+LACUNA_AVX2 inline Dir8 gather_dir8(const float (*d)[kShadeRecords], __m256i rec) {
+    return {_mm256_i32gather_ps(d[0], rec, 4), _mm256_i32gather_ps(d[1], rec, 4),
+            _mm256_i32gather_ps(d[2], rec, 4)};
+}
+
+// Shades the first min(q.n, 8) queued samples into their records and drops them from the queue.
+template <class T>
+LACUNA_AVX2 void shade_queue8(const ShadeFrame& f, const T* data, ShadeQueue& q, ShadeRecords& R) {
+    const int n = std::min(q.n, 8);
+    if (n == 0) return;
+    for (int j = n; j < 8; ++j)  // padding (computed, never used)
+        q.x[j] = q.x[n - 1], q.y[j] = q.y[n - 1], q.z[j] = q.z[n - 1], q.rec[j] = q.rec[n - 1];
+    alignas(32) float gx[8], gy[8], gz[8];
+    if (f.grad)
+        volume_gradients8(f.g, f.grad, q.x, q.y, q.z, gx, gy, gz);
+    else
+        gradients8(f.g, data, q.x, q.y, q.z, gx, gy, gz);
+    alignas(32) float r[8], g[8], b[8];
+    for (int j = 0; j < 8; ++j) {
+        const float* c = f.raw + 4 * ptrdiff_t(q.e[std::min(j, n - 1)]);
+        r[j] = c[0], g[j] = c[1], b[j] = c[2];
+    }
+    const __m256i rec = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.rec));
+    const __m256 h_ok = _mm256_castsi256_ps(
+        _mm256_i32gather_epi32(reinterpret_cast<const int*>(R.h_ok), rec, 4));
+    phong8(f.phong, f.li, gather_dir8(R.l, rec), gather_dir8(R.v, rec), gather_dir8(R.h, rec), h_ok,
+           gx, gy, gz, r, g, b, n);
+    for (int j = 0; j < n; ++j) {
+        const int i = q.rec[j];
+        const float w = q.w[j], a = q.a[j];
+        R.r[i] += w * r[j] * a;
+        R.g[i] += w * g[j] * a;
+        R.b[i] += w * b[j] * a;
+        --R.pending[i];
+    }
+    q.n -= n;
+    for (int j = 0; j < q.n; ++j) {
+        q.x[j] = q.x[n + j], q.y[j] = q.y[n + j], q.z[j] = q.z[n + j];
+        q.w[j] = q.w[n + j], q.a[j] = q.a[n + j], q.e[j] = q.e[n + j], q.rec[j] = q.rec[n + j];
+    }
+}
+
+// march_lanes8's contract (refill, the lanes' state in `s`), with `lut` the step-corrected LUT
+// (RGBA floats, entry g.zero_entry all zero) for the opacity chain, `rec[l]` lane l's record;
+// s.r, s.g, s.b are not used (colours live in the records). Samples go to `q` and are shaded
+// whenever eight wait; the caller shades what is left after the kernel returns.
+template <class T, class Refill, bool kLeap = false>
+LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                                     const ShadeFrame& f, ShadeQueue& q, ShadeRecords& R,
+                                     const int32_t* rec, Refill& refill) {
+    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.f);
+    const __m256 vdt = _mm256_set1_ps(g.dt), vert = _mm256_set1_ps(g.ert);
+    const __m256 voff = _mm256_set1_ps(g.lut_offset), vscale = _mm256_set1_ps(g.lut_scale),
+                 vlast = _mm256_set1_ps(g.lut_last);
+    const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
+    __m256 ox, oy, oz, dx, dy, dz, tb, aa;
+    __m256i kend, active, k, n;
+#define LACUNA_LOAD_LANES                                                             \
+    ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz);  \
+    dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz);  \
+    tb = _mm256_load_ps(s.t_base);                                                    \
+    kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));               \
+    active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));           \
+    k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));                     \
+    n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
+    aa = _mm256_load_ps(s.a);                                                         \
+    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
+    if constexpr (kLeap)                                                              \
+        lscale = _mm256_div_ps(_mm256_set1_ps(4.f),                                   \
+                               _mm256_mul_ps(vdt, _mm256_max_ps(_mm256_andnot_ps(sign, dx),      \
+                                             _mm256_max_ps(_mm256_andnot_ps(sign, dy),          \
+                                                           _mm256_andnot_ps(sign, dz)))));
+    const __m256 sign = _mm256_set1_ps(-0.f);
+    __m256 lscale = _mm256_setzero_ps();  // leaping: 4 / (dt * max|dir|), per lane
+    int active_mask, waiting = 0;
+    LACUNA_LOAD_LANES
+    int need;
+    for (;;) {
+        const __m256i valid = _mm256_cmpgt_epi32(kend, k);
+        const __m256 t =
+            _mm256_add_ps(tb, _mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(k), half), vdt));
+        const __m256 x = _mm256_add_ps(ox, _mm256_mul_ps(t, dx));
+        const __m256 y = _mm256_add_ps(oy, _mm256_mul_ps(t, dy));
+        const __m256 z = _mm256_add_ps(oz, _mm256_mul_ps(t, dz));
+        const __m256 v = trilinear8(g, data, x, y, z);
+        __m256i taken = valid, adv = _mm256_set1_epi32(1);
+        if constexpr (kLeap) leap8(g, x, y, z, valid, lscale, taken, adv);
+        __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
+        u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
+        const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), taken);
+        const __m256 ca = _mm256_i32gather_ps(lut + 3, _mm256_slli_epi32(entry, 2), 4);
+        const __m256 w = _mm256_sub_ps(one, aa);
+        aa = _mm256_add_ps(aa, _mm256_mul_ps(w, ca));
+        // The visible samples (a > 0; invalid lanes read the zero entry) join the queue.
+        if (int vis = _mm256_movemask_ps(_mm256_cmp_ps(ca, zero, _CMP_GT_OQ))) {
+            alignas(32) float px[8], py[8], pz[8], pw[8], pa[8];
+            alignas(32) int32_t pe[8];
+            _mm256_store_ps(px, x), _mm256_store_ps(py, y), _mm256_store_ps(pz, z);
+            _mm256_store_ps(pw, w), _mm256_store_ps(pa, ca);
+            _mm256_store_si256(reinterpret_cast<__m256i*>(pe), entry);
+            do {
+                const int l = __builtin_ctz(unsigned(vis));
+                vis &= vis - 1;
+                const int j = q.n++;
+                q.x[j] = px[l], q.y[j] = py[l], q.z[j] = pz[l];
+                q.w[j] = pw[l], q.a[j] = pa[l], q.e[j] = pe[l], q.rec[j] = rec[l];
+                ++R.pending[rec[l]];
+            } while (vis);
+            if (q.n >= 8) shade_queue8(f, data, q, R);
+        }
+        n = _mm256_sub_epi32(n, taken);
+        if constexpr (kLeap)
+            k = _mm256_min_epi32(_mm256_add_epi32(k, _mm256_and_si256(adv, valid)), kend);
+        else
+            k = _mm256_sub_epi32(k, valid);
+        const __m256i over = _mm256_or_si256(
+            _mm256_cmpeq_epi32(k, kend), _mm256_castps_si256(_mm256_cmp_ps(aa, vert, _CMP_GE_OS)));
+        kend = _mm256_blendv_epi8(kend, k, over);
+        need = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(over, active)));
+        waiting |= need;
+        if (__builtin_popcount(unsigned(waiting)) >= 2 || waiting == active_mask) {
+            need = waiting;
+            waiting = 0;
+            _mm256_store_si256(reinterpret_cast<__m256i*>(s.kend), kend);
+            _mm256_store_si256(reinterpret_cast<__m256i*>(s.k), k);
+            _mm256_store_si256(reinterpret_cast<__m256i*>(s.n), n);
+            _mm256_store_ps(s.a, aa);
+            if (!refill(need)) return;
+            LACUNA_LOAD_LANES
+        }
+    }
+#undef LACUNA_LOAD_LANES
+}
 
 #endif  // LACUNA_SIMD_X86
 

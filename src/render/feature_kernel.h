@@ -28,6 +28,7 @@
 #include <type_traits>
 
 #include "accel/cursor.h"
+#include "render/lane_scheduler.h"
 #include "render/pixel_driver.h"
 #include "accel/entry_window.h"
 #include "accel/no_accel.h"
@@ -757,5 +758,123 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
         }
     }
 }
+
+// ---- Shaded rays in lanes (AVX2 and AVX-512 CPUs): simd::march_shaded_lanes8 ----------------
+//
+// For Phong composite rays with a head or directional light, one TF and no clipping
+// (lanes_shade() says when): the lane scheduler (render/lane_scheduler.h) with this policy.
+// A ray's record (simd::ShadeRecords) holds its colour and its fixed light; when the ray is done
+// its pixel is written at once if none of its samples still waits in the shading queue, else as
+// soon as the queue has shaded them (poll, at every refill) or at the tile's end (drain).
+inline bool lanes_shade(const Context& c) {
+    const FeatureOptions& f = *c.f;
+    return f.shading == ShadingModel::Phong && f.light.kind != LightKind::Spot && !c.two_tfs &&
+           c.n_clips == 0 && !f.crop && !c.nearest && c.ert > 0.f;
+}
+
+#if LACUNA_SIMD_X86
+template <class T>
+class ShadedLanesPolicy {
+public:
+    ShadedLanesPolicy(const Context& c, const simd::ShadeFrame& sf, const T* data, RenderResult& out,
+                      const RenderOptions& opt)
+        : m_c(c), m_sf(sf), m_data(data), m_out(out), m_opt(opt) {
+        for (int i = 0; i < simd::kShadeRecords; ++i) m_free[i] = simd::kShadeRecords - 1 - i;
+        m_nfree = simd::kShadeRecords;
+    }
+    const int32_t* lane_records() const { return m_rec; }
+    simd::ShadeQueue& queue() { return m_q; }
+    simd::ShadeRecords& records() { return m_R; }
+
+    // render_tile's lattice: t_near + (j - 0.5) * dt, j the pixel's jitter or 0.5.
+    float t_base(int x, int y, float t_near) const {
+        const FeatureOptions& f = *m_c.f;
+        const float j = f.jitter ? jitter(uint32_t(x), uint32_t(y), f.jitter_seed) : 0.5f;
+        return t_near + (j - 0.5f) * m_c.dt;
+    }
+    // ShadedStream's per-ray light: l (the view for a head light), and the half vector.
+    void begin(int lane, int x, int y, Vec3f dir) {
+        const int i = m_free[--m_nfree];
+        m_rec[lane] = i;
+        m_R.r[i] = m_R.g[i] = m_R.b[i] = 0.f;
+        m_R.pending[i] = 0;
+        const Vec3f view = -dir;
+        const Vec3f l = m_c.f->light.kind == LightKind::Head ? view : m_c.light_dir;
+        Vec3f h{0, 0, 1};
+        m_R.h_ok[i] = shading::half_vector(l, view, h) ? -1 : 0;
+        const Vec3f d[3] = {l, view, h};
+        float(*dst[3])[simd::kShadeRecords] = {m_R.l, m_R.v, m_R.h};
+        for (int q = 0; q < 3; ++q) dst[q][0][i] = d[q].x, dst[q][1][i] = d[q].y, dst[q][2][i] = d[q].z;
+        m_x[i] = x, m_y[i] = y;
+    }
+    void finish(int lane, int, int, const simd::Lanes& L) {
+        const int i = m_rec[lane];
+        m_a[i] = L.a[lane];
+        m_n[i] = uint32_t(L.n[lane]);
+        if (m_R.pending[i] == 0)
+            write(i);
+        else
+            m_deferred[m_ndeferred++] = i;
+    }
+    void empty(int x, int y) { write_pixel(m_out, m_opt, x, y, kernel::Accum{}, 0); }
+    void poll() {
+        int kept = 0;
+        for (int d = 0; d < m_ndeferred; ++d) {
+            const int i = m_deferred[d];
+            if (m_R.pending[i] == 0)
+                write(i);
+            else
+                m_deferred[kept++] = i;
+        }
+        m_ndeferred = kept;
+    }
+    void drain() {
+        while (m_q.n > 0) simd::shade_queue8(m_sf, m_data, m_q, m_R);
+        poll();
+    }
+
+private:
+    void write(int i) {
+        write_pixel(m_out, m_opt, m_x[i], m_y[i], kernel::Accum{m_R.r[i], m_R.g[i], m_R.b[i], m_a[i]},
+                    m_n[i]);
+        m_free[m_nfree++] = i;
+    }
+    const Context& m_c;
+    const simd::ShadeFrame& m_sf;
+    const T* m_data;
+    RenderResult& m_out;
+    const RenderOptions& m_opt;
+    simd::ShadeRecords m_R{};
+    simd::ShadeQueue m_q{};
+    alignas(32) int32_t m_rec[simd::kMaxLanes] = {};
+    int m_free[simd::kShadeRecords], m_nfree = 0;
+    int m_deferred[simd::kShadeRecords], m_ndeferred = 0;
+    int m_x[simd::kShadeRecords] = {}, m_y[simd::kShadeRecords] = {};
+    float m_a[simd::kShadeRecords] = {};
+    uint32_t m_n[simd::kShadeRecords] = {};
+};
+
+// One tile of shaded rays in lanes, leaping through the refined `grid` (leap_map() set).
+// `corr_z`: the step-corrected LUT with a zero entry appended.
+template <class T>
+void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Volume& vol, const T* data,
+                              const simd::ShadeFrame& sf, const std::vector<Rgba>& corr_z,
+                              const Camera& cam, const RenderOptions& opt, int x0, int y0, int x1,
+                              int y1, RenderResult& out, Counts& counts) {
+    const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
+    simd::LaneGrid lg = lane_grid(g, c.dt, c.map, corr_z.size(), c.ert);
+    set_leap(lg, grid);
+    ShadedLanesPolicy<T> policy(c, sf, data, out, opt);
+    const float* lut = &corr_z[0].r;
+    // Every ray one run: the lanes leap (core/simd_lanes.h).
+    static const NoAccel kWholeRay;
+    schedule_tile_lanes<8>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
+                           counts.samples, counts.rays, [&](simd::Lanes& L, auto& refill) {
+                               simd::march_shaded_lanes8<T, std::remove_reference_t<decltype(refill)>, true>(
+                                   L, lg, data, lut, sf, policy.queue(), policy.records(),
+                                   policy.lane_records(), refill);
+                           });
+}
+#endif
 
 }  // namespace lacuna::feature

@@ -235,6 +235,35 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             };
             const simd::Isa isa = batched ? simd::active_isa() : simd::Isa::Scalar;
 #if LACUNA_SIMD_X86
+            // The refined grid, Phong with a fixed light, one TF, no clipping: shaded rays in
+            // lanes, leaping (simd::march_shaded_lanes8; tiles too large for the scheduler take
+            // ShadedStream).
+            if constexpr (std::is_same_v<std::decay_t<decltype(acc)>, BrickGrid>) {
+                if ((isa == simd::Isa::Avx2 || isa == simd::Isa::Avx512) && feature::lanes_shade(c) &&
+                    acc.leap_map()) {
+                    std::vector<Rgba> corr_z = corr0;
+                    corr_z.push_back(Rgba{});  // the zero entry idle lanes composite
+                    simd::ShadeGrid sg_lanes = sg;
+                    sg_lanes.cell_mask = nullptr;
+                    const simd::ShadeFrame sf{sg_lanes, &c.raw[0][0].r, c.grad[0] ? c.grad : nullptr,
+                                              {f.phong.ambient, f.phong.diffuse, f.phong.specular, f.phong.power},
+                                              f.light.intensity};
+                    parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                                       [&](int x0, int y0, int x1, int y1) {
+                                           feature::Counts n;
+                                           if ((x1 - x0) * (y1 - y0) <= kMaxTilePixels)
+                                               feature::render_tile_shaded_lanes(c, acc, m_volume, data, sf,
+                                                                                 corr_z, cam, opt, x0, y0,
+                                                                                 x1, y1, out, n);
+                                           else
+                                               feature::render_tile<feature::ShadeOps<8>>(
+                                                   c, acc, g, sg, cam, opt, x0, y0, x1, y1, out, n);
+                                           samples += n.samples;
+                                           rays += n.rays;
+                                       });
+                    return;
+                }
+            }
             if (isa == simd::Isa::Avx512) return frame(std::type_identity<feature::ShadeOps<16>>{});
             if (isa == simd::Isa::Avx2) return frame(std::type_identity<feature::ShadeOps<8>>{});
 #if defined(__SSE4_1__)

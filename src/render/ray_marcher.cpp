@@ -12,6 +12,7 @@
 #include "core/simd_lanes.h"
 #include "lacuna/error.h"
 #include "render/marcher_cache.h"
+#include "render/lane_scheduler.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 #include "render/volume_frame.h"
@@ -126,139 +127,23 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
     rays += tile_rays;
 }
 
-// The same tile, W rays at a time (core/simd_lanes.h: one ray per lane, each composited in its
-// own sample order, so the bits are those of render_tile). The scheduler keeps the lanes full: a
-// lane whose run ends pulls the ray's next run from its cursor; a lane whose ray is done (no runs
-// left, or opaque) writes its pixel and takes the tile's next ray. `march` runs the lanes and
-// calls `refill` with the mask of the lanes that wait.
-constexpr int kMaxTilePixels = 64 * 64;
-
+// The same tile, W rays at a time (render/lane_scheduler.h; core/simd_lanes.h: one ray per
+// lane, each composited in its own sample order, so the bits are those of render_tile).
 template <int W, class T, class S, class March>
 void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const Camera& cam,
                        const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
                        int x0, int y0, int x1, int y1, RenderResult& out,
                        std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March&& march,
                        const BrickGrid* leap = nullptr) {
-    using Cursor = typename S::Cursor;
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
-    const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, opt.step);
-    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
-    const float chunk = opt.ert < 1.f ? kLaneChunk * dt : 0.f;
-    const simd::LaneGrid lg{dt,
-                            {g.hi_x, g.hi_y, g.hi_z},
-                            {g.cell_x, g.cell_y, g.cell_z},
-                            int32_t(g.sy),
-                            int32_t(g.sz),
-                            map.offset(),
-                            map.scale(),
-                            float(map.last()),
-                            int32_t(lut.size() - 1),  // the zero entry render() appends
-                            opt.ert,
-                            leap ? leap->leap_map() : nullptr,
-                            leap ? leap->leap_dims()[0] : 0,
-                            leap ? leap->leap_dims()[0] * leap->leap_dims()[1] : 0};
-    struct Slot {
-        int x = 0, y = 0;
-        std::optional<Cursor> cursor;
-        std::optional<LatticeRuns<Cursor>> runs;
-    };
-    simd::Lanes L{};
-    Slot slot[W];
-    // Rays enter the lanes in 4x4 pixel blocks, not rows: the lanes' sample positions then
-    // stay in a compact tube of voxels, so the cache lines one block loads serve its neighbours.
-    const int w = x1 - x0, h = y1 - y0, npix = w * h;
-    int order[kMaxTilePixels][2];
-    {
-        int q = 0;
-        for (int by = 0; by < h; by += 4)
-            for (int bx = 0; bx < w; bx += 4)
-                for (int y = by; y < std::min(by + 4, h); ++y)
-                    for (int x = bx; x < std::min(bx + 4, w); ++x) {
-                        order[q][0] = x0 + x;
-                        order[q][1] = y0 + y;
-                        ++q;
-                    }
-    }
-    int next_pixel = 0, live = 0;
+    simd::LaneGrid lg = lane_grid(g, dt, map, lut.size(), opt.ert);
+    if (leap) set_leap(lg, *leap);
+    CompositePolicy policy{out, opt};
     uint64_t tile_samples = 0, tile_rays = 0;
-    // Rays are set up eight at a time (AVX2, on the 8- and 16-lane paths) in pixel order.
-    constexpr bool kBatchSetup = W >= 8;
-    const simd::CameraView cv = camera_view(cam);
-    const float isp[3] = {inv_sp.x, inv_sp.y, inv_sp.z};
-    simd::RayBatch8 rb;
-    int rb_base = -8;
-    auto ray_of = [&](int q, kernel::IndexRay& r, float& t_near, float& t_far) {
-        if constexpr (kBatchSetup) {
-            if (q >= rb_base + 8) {
-                rb_base = q;
-                alignas(32) float px[8], py[8];
-                for (int i = 0; i < 8; ++i) {
-                    const int j = std::min(q + i, npix - 1);
-                    px[i] = float(order[j][0]), py[i] = float(order[j][1]);
-                }
-                simd::setup_rays8(cv, px, py, isp, hi, rb);
-            }
-            const int i = q - rb_base;
-            r = {rb.ox[i], rb.oy[i], rb.oz[i], rb.dx[i], rb.dy[i], rb.dz[i]};
-            t_near = rb.t_near[i], t_far = rb.t_far[i];
-            return rb.hit[i] != 0;
-        } else {
-            r = index_ray(cam.generate(float(order[q][0]), float(order[q][1])), inv_sp);
-            return kernel::intersect_box(r, hi, t_near, t_far);
-        }
-    };
-    // Puts the tile's next ray with at least one run into lane l (pixels without one are written
-    // on the way); idles the lane when the tile has no rays left.
-    auto start = [&](int l) {
-        while (next_pixel < npix) {
-            const int x = order[next_pixel][0], y = order[next_pixel][1];
-            kernel::IndexRay r;
-            float t_near, t_far;
-            int kb, ke;
-            if (ray_of(next_pixel++, r, t_near, t_far)) {
-                ++tile_rays;
-                Slot& sl = slot[l];
-                sl.runs.reset();
-                sl.cursor.emplace(accel, cursor_ray(r), t_near, t_far, dt, chunk);
-                sl.runs.emplace(*sl.cursor, t_near, dt, lattice_end(t_near, t_far, dt));
-                if (sl.runs->next(kb, ke)) {
-                    sl.x = x, sl.y = y;
-                    L.ox[l] = r.ox, L.oy[l] = r.oy, L.oz[l] = r.oz;
-                    L.dx[l] = r.dx, L.dy[l] = r.dy, L.dz[l] = r.dz;
-                    L.t_base[l] = t_near;
-                    L.k[l] = kb, L.kend[l] = ke;
-                    L.r[l] = L.g[l] = L.b[l] = L.a[l] = 0.f;
-                    L.n[l] = 0;
-                    L.active[l] = -1;
-                    ++live;
-                    return;
-                }
-            }
-            write_pixel(out, opt, x, y, kernel::Accum{}, 0);
-        }
-        L.active[l] = 0;
-        L.k[l] = L.kend[l] = 0;
-    };
-    // The lanes that need it: the ray's next run, or its pixel and the tile's next ray.
-    auto refill = [&](int need) {
-        for (int l = 0; l < W; ++l) {
-            if (!(need >> l & 1)) continue;
-            int kb, ke;
-            if (!(L.a[l] >= opt.ert) && slot[l].runs->next(kb, ke)) {
-                L.k[l] = kb, L.kend[l] = ke;
-                continue;
-            }
-            write_pixel(out, opt, slot[l].x, slot[l].y,
-                        kernel::Accum{L.r[l], L.g[l], L.b[l], L.a[l]}, uint32_t(L.n[l]));
-            tile_samples += uint32_t(L.n[l]);
-            --live;
-            start(l);
-        }
-        return live > 0;
-    };
-    for (int l = 0; l < W; ++l) start(l);
-    if (live > 0) march(L, lg, data, &lut[0].r, refill);
+    schedule_tile_lanes<W>(accel, vol, cam, dt, opt.ert < 1.f ? kLaneChunk * dt : 0.f, opt.ert,
+                           x0, y0, x1, y1, policy, tile_samples, tile_rays,
+                           [&](simd::Lanes& L, auto& refill) { march(L, lg, data, &lut[0].r, refill); });
     samples += tile_samples;
     rays += tile_rays;
 }

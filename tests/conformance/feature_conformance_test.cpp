@@ -282,6 +282,54 @@ TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
     EXPECT_GT(compared, 500);
 }
 
+// The refined grid's shaded lanes (simd::march_shaded_lanes8 with leaping, taken for Phong with a
+// head or directional light) on volumes whose background is transparent, so the leap map has
+// long empty stretches: every path equals the scalar --accel none render.
+TEST(FeatureConformance, ShadedLeapingLanesAreExactOnSparseVolumes) {
+    const test::KernelPaths kp;
+    Rng rng{4242};
+    int compared = 0;
+    for (int trial = 0; trial < 12; ++trial) {
+        const Volume v = test::random_volume(rng, 48);
+        TransferLut lut = test::random_lut(v.vis_range(), rng);
+        const ValueToLut map = lut.map();
+        // The background (the volume's minimum, most voxels) and a band above it transparent.
+        const int band = map(v.data_range().min) + rng.range(0, 40);
+        for (int e = 0; e <= std::min(band, int(lut.entries.size()) - 1); ++e) lut.entries[size_t(e)].a = 0.f;
+        if (trial % 3 == 1) test::make_dense(lut, size_t(1) << 14, rng), lut.entries[0].a = 0.f;
+        RenderOptions o;
+        o.keep_float = true;
+        o.step = 0.2f + 1.2f * rng.uniform();
+        o.ert = trial % 2 ? 2.f : 0.8f + 0.19f * rng.uniform();
+        o.features.shading = ShadingModel::Phong;
+        o.features.light.kind = trial % 4 < 2 ? LightKind::Head : LightKind::Directional;
+        o.features.light.direction = {rng.uniform() - 0.5f, rng.uniform() - 0.5f, 0.5f};
+        o.features.jitter = trial % 3 == 2;
+        const Camera cam = test::random_camera(v, rng, 23);
+        RayMarcher m(v);
+        m.set_transfer_function(lut);
+        simd::set_isa(simd::Isa::Scalar);
+        const RenderResult ref = m.render(cam, o);
+        auto accel = make_accel(AccelKind::Grid, v);
+        accel->set_transfer_function(lut);
+        accel->refine();
+        m.set_accel(accel.get());
+        for (simd::Isa isa : kp.paths) {
+            simd::set_isa(isa);
+            const RenderResult r = m.render(cam, o);
+            const std::string what = "trial " + std::to_string(trial) + " " + to_string(v.type()) +
+                                     " path " + simd::to_string(isa);
+            ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
+            ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
+                                     ref.rgba_float.size() * sizeof(float)))
+                << what << ": float accumulations differ";
+            ASSERT_LE(r.stats.samples, ref.stats.samples) << what;
+            ++compared;
+        }
+    }
+    EXPECT_GT(compared, 20);
+}
+
 TEST(FeatureConformance, AcceleratedShadowRaysEqualUnacceleratedOnes) {
     Rng rng{77};
     for (int trial = 0; trial < 6; ++trial) {
