@@ -8,6 +8,7 @@
 #pragma once
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -17,6 +18,7 @@
 
 #include "lacuna/error.h"
 #include "lacuna/io.h"
+#include "lacuna/orientation.h"
 
 #ifndef LACUNA_FUZZ_TMP
 #define LACUNA_FUZZ_TMP "/tmp"
@@ -59,6 +61,16 @@ inline void read_expecting_errors(const std::string& path, const ReadOptions& o 
     try {
         const Volume v = read_volume(path, o);
         if (!v.data()) std::abort();
+        // A volume read has a world the renderers' float can hold (check_geometry's rules):
+        // finite float bounds, an orientation code.
+        const Box3f b = world_bounds(v);
+        for (int a = 0; a < 3; ++a)
+            if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a]) || !(b.lo[a] <= b.hi[a])) {
+                std::fprintf(stderr, "fuzz: world bounds not finite on axis %d: %g .. %g\n", a,
+                             double(b.lo[a]), double(b.hi[a]));
+                std::abort();
+            }
+        if (orientation_code(v).size() != 3) std::abort();
     } catch (const Error& e) {
         const std::string m = e.what();
         if (m.find('\n') != std::string::npos) {
