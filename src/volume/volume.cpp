@@ -139,6 +139,15 @@ void Volume::compute_range(const std::string& where) {
         throw Error(where, "voxel values",
                     "expected max - min within float (3.4e38), got " + std::to_string(lo) +
                         " .. " + std::to_string(hi));
+    // Float voxels within an ulp of float's end (fuzz_value_to_lut: corners 1.16e38 and 3.4e38):
+    // a trilinear lerp a + f * (b - a) can round one ulp past its corners, which at 3.4e38 is
+    // inf. Below 2^127 (1.7e38) three lerps' ulps cannot reach 2^128. Equal corners lerp
+    // exactly, so a constant volume is kept.
+    if (m_type == VoxelType::Float32 && lo != hi && std::max(-lo, hi) > 0x1p127f)
+        throw Error(where, "voxel values",
+                    "expected values within +-1.7e38 (a trilinear sample rounds up to an ulp past "
+                    "its corners, and float ends at 3.4e38), got " +
+                        std::to_string(lo) + " .. " + std::to_string(hi));
     m_data_range = {lo, hi};
     if (!m_vis_set) {
         m_vis_range = m_data_range;

@@ -11,6 +11,7 @@
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
+#include "render/ray_march_kernel.h"
 
 namespace lacuna {
 namespace {
@@ -132,6 +133,37 @@ TEST(LutRange, FloatDataWiderThanFloatIsRejected) {
     }
     Volume ok = float_volume({-1.5e38f, 1.5e38f});
     EXPECT_NO_THROW(ok.compute_range("ok.nii"));
+}
+
+// fuzz_value_to_lut: corners of 1.16e38 and 3.4e38 lerped at z = 1 rounded one ulp past 3.4e38,
+// an inf sample. The boundary refuses non-constant float data beyond 2^127, and every sample of
+// data up to it, corners at both ends, is finite.
+TEST(LutRange, FloatDataWithinAnUlpOfFloatsEndIsRejected) {
+    Volume v = float_volume({1.1630922e38f, 1.1630922e38f, 1.1630922e38f, 1.1630922e38f, kMax,
+                             kMax, kMax, kMax});
+    try {
+        v.compute_range("edge.nii");
+        FAIL() << "accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("edge.nii: voxel values:"), std::string::npos)
+            << e.what();
+    }
+    const float top = 0x1p127f;
+    for (const std::vector<float>& corners : std::vector<std::vector<float>>{
+             {top * 0.68f, top * 0.68f, top * 0.68f, top * 0.68f, top, top, top, top},
+             {-1e7f, 1e-38f, top * 0.68f, 0.f, top, 0.f, top, 0.f},
+             {top, 0.f, top, 0.f, top, 0.f, top, 0.f}}) {
+        Volume ok = float_volume(corners);
+        ASSERT_NO_THROW(ok.compute_range("ok.nii"));
+        const auto grid = kernel::make_grid(ok.data_as<float>(), ok.dims());
+        for (int a = 0; a <= 64; ++a)
+            for (int b = 0; b <= 64; ++b)
+                for (int c = 0; c <= 64; ++c) {
+                    const float s = kernel::trilinear(grid, a / 64.f, b / 64.f, c / 64.f);
+                    ASSERT_TRUE(std::isfinite(s)) << a << " " << b << " " << c;
+                    ASSERT_LE(s, top * (1 + 0x1p-20f));
+                }
+    }
 }
 
 TEST(LutRange, NarrowOrConstantDataGetsAUsableDefaultRange) {
