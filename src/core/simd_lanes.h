@@ -433,6 +433,25 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, co
     }
 }
 
+// Leaping's per-lane scale 4 / (dt * max|dir|): fine-brick edges (4 cells) per sample.
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 leap_scale8(__m256 vdt, __m256 dx, __m256 dy,
+                                                                  __m256 dz) {
+    const __m256 sign = _mm256_set1_ps(-0.f);
+    return _mm256_div_ps(_mm256_set1_ps(4.f),
+                         _mm256_mul_ps(vdt, _mm256_max_ps(_mm256_andnot_ps(sign, dx),
+                                                          _mm256_max_ps(_mm256_andnot_ps(sign, dy),
+                                                                        _mm256_andnot_ps(sign, dz)))));
+}
+// The valid lanes' next sample: k + 1, or leaping k + adv (at most kend).
+template <bool kLeap>
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256i advance8(__m256i k, __m256i kend,
+                                                                __m256i valid, __m256i adv) {
+    if constexpr (kLeap)
+        return _mm256_min_epi32(_mm256_add_epi32(k, _mm256_and_si256(adv, valid)), kend);
+    else
+        return _mm256_sub_epi32(k, valid);
+}
+
 // Leaping, eight lanes (see "Leaping" above): for the valid lanes whose sample (x, y, z, not
 // yet clamped) lies in an empty fine brick, taken loses the lane and adv becomes its skip.
 LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, __m256 x, __m256 y,
@@ -487,12 +506,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
     ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);     \
     aa = _mm256_load_ps(s.a);                                                         \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
-    if constexpr (kLeap)                                                              \
-        lscale = _mm256_div_ps(_mm256_set1_ps(4.f),                                   \
-                               _mm256_mul_ps(vdt, _mm256_max_ps(_mm256_andnot_ps(sign, dx),      \
-                                             _mm256_max_ps(_mm256_andnot_ps(sign, dy),          \
-                                                           _mm256_andnot_ps(sign, dz)))));
-    const __m256 sign = _mm256_set1_ps(-0.f);
+    if constexpr (kLeap) lscale = leap_scale8(vdt, dx, dy, dz);
     __m256 lscale = _mm256_setzero_ps();  // leaping: 4 / (dt * max|dir|), per lane
     int active_mask, waiting = 0;
     LACUNA_LOAD_LANES
@@ -536,10 +550,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
         ab = _mm256_add_ps(ab, _mm256_mul_ps(w, cb));
         aa = _mm256_add_ps(aa, _mm256_mul_ps(w, ca));
         n = _mm256_sub_epi32(n, taken);
-        if constexpr (kLeap)
-            k = _mm256_min_epi32(_mm256_add_epi32(k, _mm256_and_si256(adv, valid)), kend);
-        else
-            k = _mm256_sub_epi32(k, valid);
+        k = advance8<kLeap>(k, kend, valid, adv);
         const __m256i over = _mm256_or_si256(
             _mm256_cmpeq_epi32(k, kend), _mm256_castps_si256(_mm256_cmp_ps(aa, vert, _CMP_GE_OS)));
         // A lane whose run is over, or which is opaque, waits (kend = k makes it invalid) until

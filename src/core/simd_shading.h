@@ -551,8 +551,9 @@ LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data
 
 // ---- Shading across rays (AVX2): the shaded lane kernel ---------------------------------
 // march_shaded_lanes8 is march_lanes8 (core/simd_lanes.h) for Phong-shaded composite rays with
-// a head or directional light, one TF, no clipping, trilinear samples (the render side chooses
-// it: src/render/feature_render.cpp). ShadedStream (src/render/feature_kernel.h) shades one ray
+// a head or directional light, one TF, no clipping, trilinear samples; the render side
+// (src/render/feature_render.cpp) takes it with leaping on a refined grid, where it pays (alone,
+// walking the grid, it measured no faster than ShadedStream). ShadedStream (src/render/feature_kernel.h) shades one ray
 // at a time: a ray keeps ~25 samples, of which ~4 are visible, so its lattice and its gradient
 // batches run mostly empty lanes. Here lanes are rays, as in the unshaded kernel, and the
 // visible samples of all lanes go to one queue, shaded eight at a time whoever they belong to.
@@ -660,12 +661,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
     n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
     aa = _mm256_load_ps(s.a);                                                         \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
-    if constexpr (kLeap)                                                              \
-        lscale = _mm256_div_ps(_mm256_set1_ps(4.f),                                   \
-                               _mm256_mul_ps(vdt, _mm256_max_ps(_mm256_andnot_ps(sign, dx),      \
-                                             _mm256_max_ps(_mm256_andnot_ps(sign, dy),          \
-                                                           _mm256_andnot_ps(sign, dz)))));
-    const __m256 sign = _mm256_set1_ps(-0.f);
+    if constexpr (kLeap) lscale = leap_scale8(vdt, dx, dy, dz);
     __m256 lscale = _mm256_setzero_ps();  // leaping: 4 / (dt * max|dir|), per lane
     int active_mask, waiting = 0;
     LACUNA_LOAD_LANES
@@ -704,10 +700,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
             if (q.n >= 8) shade_queue8(f, data, q, R);
         }
         n = _mm256_sub_epi32(n, taken);
-        if constexpr (kLeap)
-            k = _mm256_min_epi32(_mm256_add_epi32(k, _mm256_and_si256(adv, valid)), kend);
-        else
-            k = _mm256_sub_epi32(k, valid);
+        k = advance8<kLeap>(k, kend, valid, adv);
         const __m256i over = _mm256_or_si256(
             _mm256_cmpeq_epi32(k, kend), _mm256_castps_si256(_mm256_cmp_ps(aa, vert, _CMP_GE_OS)));
         kend = _mm256_blendv_epi8(kend, k, over);

@@ -218,7 +218,7 @@ TEST(FeatureConformance, EveryOptionIsExactForEveryStructure) {
 
 // Every kernel path this CPU runs (core/simd_lanes.h: the scalar path is feature::composite_ray,
 // one sample at a time; SSE4.1, AVX2 and AVX-512 run the batched ShadedStream with the lanes of
-// core/simd_shading.h) gives the bytes, float accumulations and per-pixel sample counts of the
+// core/simd_shading.h, and on a refined grid AVX2/AVX-512 the leaping shaded lanes) gives the bytes, float accumulations and per-pixel sample counts of the
 // scalar --accel none render, for every feature option and structure, with and without early
 // termination. Half the trials use a dense LUT (every entry different, so a value one ulp off
 // lands in another entry and shows).
