@@ -330,10 +330,11 @@ void read_series_child(const std::string& dir, const MemoryBudget& budget, int m
     std::vector<std::string>& files = series.files;
     if (files.empty()) throw Error(dir, "DICOM series", "no DICOM series found in this folder");
     // GDCM's scanner skips files it cannot parse: a damaged slice would vanish from the series
-    // without a word. A file that claims to be DICOM ("DICM" at byte 128, or named .dcm) and
-    // is in no series is an error; other files (notes, thumbnails) are ignored.
+    // without a word. A file that claims to be DICOM ("DICM" at byte 128, a first tag GDCM
+    // reads as DICOM, or named .dcm) and is in no series is an error; other files (notes,
+    // thumbnails) are ignored.
     for (const auto& [path, walk] : walks)
-        if ((walk.part10 || to_lower(fs::path(path).extension().string()) == ".dcm") &&
+        if ((walk.part10 || walk.dicom || to_lower(fs::path(path).extension().string()) == ".dcm") &&
             !series.in_any.count(path))
             throw Error(dir, file_name(path),
                         "is a DICOM file that GDCM could not place in any series (damaged?)");

@@ -1,5 +1,6 @@
 #include "io/dicom_check.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -11,12 +12,27 @@ namespace lacuna::io {
 
 namespace {
 
+// Reads up to n bytes at pos into buf; returns how many it read (fewer at the end of the file).
+using ReadAt = std::function<size_t(uint64_t pos, uint8_t* buf, size_t n)>;
+
 // VRs whose explicit form has 2 reserved bytes and a 4-byte length (PS3.5 Section 7.1.2).
 bool long_vr(const char* vr) {
     static const char* kLong[] = {"OB", "OD", "OF", "OL", "OV", "OW", "SQ",
                                   "SV", "UC", "UN", "UR", "UT", "UV"};
     for (const char* v : kLong)
         if (vr[0] == v[0] && vr[1] == v[1]) return true;
+    return false;
+}
+
+// The VRs of PS3.5 Table 6.2-1: what GDCM's VR::GetVRType recognises when it guesses the
+// encoding of a file without a file meta group (FileMetaInformation::ReadCompat).
+bool known_vr(const uint8_t* p) {
+    static const char* kVr[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL",
+                                "IS", "LO", "LT", "OB", "OD", "OF", "OL", "OV", "OW",
+                                "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC",
+                                "UI", "UL", "UN", "UR", "US", "UT", "UV"};
+    for (const char* v : kVr)
+        if (char(p[0]) == v[0] && char(p[1]) == v[1]) return true;
     return false;
 }
 
@@ -34,72 +50,114 @@ uint32_t u32(const uint8_t* p, bool big) {
                : uint32_t(p[3]) << 24 | uint32_t(p[2]) << 16 | uint32_t(p[1]) << 8 | p[0];
 }
 
-}  // namespace
+// How a data set is encoded.
+struct Encoding {
+    bool explicit_vr = true, big = false;
+};
 
-DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
+// GDCM's guess for a data set that starts at `h` (8 bytes, `got` of them read) without a file
+// meta group: FileMetaInformation::ReadCompat of GDCM 3.0, branch by branch. False when GDCM
+// gives up on the file ("Cannot find DICOM type") or reads no value of it (implicit big
+// endian, which GDCM refuses).
+bool guess_encoding(const uint8_t* h, size_t got, Encoding& enc) {
+    if (got < 4) return false;  // "Cannot read very first tag"
+    const uint16_t g = u16(h, false), e = u16(h + 2, false);
+    const bool vr = got >= 6 && known_vr(h + 4);
+    if (g == 0x0008) {
+        enc = {vr, false};
+    } else if (g == 0x0800) {  // ACR-NEMA big endian
+        if (!vr) return false;
+        enc = {true, true};
+    } else if (e == 0x0010) {  // a private creator first: implicit little endian
+        enc = {false, false};
+    } else if (vr) {
+        enc = {true, g > 0xFF || e > 0xFF};
+    } else if (g == 0 && e == 0 && got >= 8 && u32(h + 4, false) == 4) {
+        enc = {false, false};  // a (0000,0000) element of 4 bytes (a crafted file)
+    } else {
+        return false;
+    }
+    return true;
+}
+
+// At most this many top-level elements: a real slice has hundreds, a file of empty elements
+// would keep the walk busy for nothing.
+constexpr int kMaxElements = 1 << 20;
+
+DicomWalk walk(const ReadAt& read, uint64_t size, const std::string& name,
+               const std::string& dir) {
     DicomWalk w;
-    std::ifstream in(file, std::ios::binary);
-    std::error_code ec;
-    const uint64_t size = std::filesystem::file_size(file, ec);
-    if (!in || ec || size < 132) return w;
-    char magic[4] = {};
-    in.seekg(128);
-    in.read(magic, 4);
-    if (std::memcmp(magic, "DICM", 4) != 0) return w;
-    w.part10 = true;
-    const std::string name = std::filesystem::path(file).filename().string();
-    bool explicit_vr = true, big = false, in_meta = true;
-    uint64_t pos = 132;
+    uint8_t h[12];
+    uint64_t pos = 0;
+    if (size >= 132 && read(128, h, 4) == 4 && std::memcmp(h, "DICM", 4) == 0) {
+        w.part10 = true;
+        pos = 132;
+    }
+    // Where GDCM starts: a file meta group (group 0002, after "DICM" or at byte 0), or a data
+    // set whose encoding it guesses from the first tag.
+    Encoding enc;
+    bool in_meta = w.part10;
+    const size_t got = read(pos, h, 8);
+    if (got >= 4 && u16(h, false) == 0x0002) {
+        in_meta = true;
+    } else if (got >= 4 || !w.part10) {
+        // A Part 10 file with no meta group, or no preamble: GDCM's guess (ReadCompat).
+        if (!guess_encoding(h, got, enc)) return w;
+        in_meta = false;
+    }
+    w.dicom = true;
     std::string syntax;
-    for (int n = 0; n < 100000 && pos + 8 <= size; ++n) {
-        uint8_t h[12];
-        in.seekg(std::streamoff(pos));
-        in.read(reinterpret_cast<char*>(h), 8);
-        if (in.gcount() != 8) return w;  // read error: left to GDCM
+    int n = 0;
+    for (; n < kMaxElements && pos + 8 <= size; ++n) {
+        if (read(pos, h, 8) != 8) return w;  // read error: left to GDCM
         const uint16_t g0 = u16(h, false);
         if (in_meta && g0 != 0x0002) {
             // The meta group ended: switch to the data set's transfer syntax (PS3.5 Annex A).
             in_meta = false;
             while (!syntax.empty() && (syntax.back() == '\0' || syntax.back() == ' '))
                 syntax.pop_back();
-            explicit_vr = syntax != "1.2.840.10008.1.2";
-            big = syntax == "1.2.840.10008.1.2.2";
+            enc.explicit_vr = syntax != "1.2.840.10008.1.2";
+            enc.big = syntax == "1.2.840.10008.1.2.2";
             if (syntax == "1.2.840.10008.1.2.1.99") return w;  // deflated: not walkable
         }
-        const uint16_t g = u16(h, big), e = u16(h + 2, big);
+        const uint16_t g = u16(h, enc.big), e = u16(h + 2, enc.big);
         uint64_t len = 0, head = 8;
         const char vr[2] = {char(h[4]), char(h[5])};
         const bool has_vr =
-            explicit_vr && vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z';
+            enc.explicit_vr && vr[0] >= 'A' && vr[0] <= 'Z' && vr[1] >= 'A' && vr[1] <= 'Z';
         if (g == 0xFFFE) return w;  // item tags at top level: leave to GDCM
         if (has_vr && long_vr(vr)) {
-            in.read(reinterpret_cast<char*>(h + 8), 4);
-            if (in.gcount() != 4) {
+            if (read(pos + 8, h + 8, 4) != 4) {
                 pos = size - 1;  // a long-VR header cut short
                 break;
             }
-            len = u32(h + 8, big);
+            len = u32(h + 8, enc.big);
             head = 12;
         } else if (has_vr) {
-            len = u16(h + 6, big);
+            len = u16(h + 6, enc.big);
         } else {
-            len = u32(h + 4, big);
+            len = u32(h + 4, enc.big);
         }
         if (len == 0xFFFFFFFFu) return w;  // undefined length: sequence or encapsulated pixels
         const uint64_t left = size - pos - head;
         if (len > left)
             throw Error(dir, name,
                         "element " + tag_text(g, e) + " says " + std::to_string(len) + " bytes, " +
-                            std::to_string(left) +
-                            " are left in the file (a damaged or truncated slice)");
+                            std::to_string(left) + " are left in the file (a damaged or " +
+                            (w.part10 ? "truncated slice)"
+                                      : "truncated slice, read without a DICOM preamble)"));
         if (in_meta && g == 0x0002 && e == 0x0010 && len < 80) {
             syntax.resize(len);
-            in.read(syntax.data(), std::streamsize(len));
+            syntax.resize(read(pos + head, reinterpret_cast<uint8_t*>(syntax.data()), len));
         }
         // Elements after Pixel Data (padding, or junk) are walked too: GDCM reads them.
         if (g == 0x7FE0 && e == 0x0010) w.pixel_data_length = int64_t(len);
         pos += head + len;
     }
+    if (n == kMaxElements && pos < size)
+        throw Error(dir, name,
+                    "has more than " + std::to_string(kMaxElements) +
+                        " top-level elements (expected a DICOM slice)");
     // Bytes left over that cannot hold an element header: GDCM asserts on these
     // (gdcmExplicitDataElement.txx: Assertion '0 && "Should not happen"').
     if (pos < size)
@@ -110,7 +168,35 @@ DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
         throw Error(dir, name,
                     "the file ends inside its file meta information (group 0002) at byte " +
                         std::to_string(pos) + " (a truncated slice)");
+    w.checked = true;
     return w;
+}
+
+}  // namespace
+
+DicomWalk walk_dicom_file(const std::string& file, const std::string& dir) {
+    std::ifstream in(file, std::ios::binary);
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(file, ec);
+    if (!in || ec) return DicomWalk{};  // unreadable: GDCM cannot read it either
+    const ReadAt read = [&](uint64_t pos, uint8_t* buf, size_t n) -> size_t {
+        in.clear();
+        in.seekg(std::streamoff(pos));
+        in.read(reinterpret_cast<char*>(buf), std::streamsize(n));
+        return size_t(std::max<std::streamsize>(in.gcount(), 0));
+    };
+    return walk(read, size, std::filesystem::path(file).filename().string(), dir);
+}
+
+DicomWalk walk_dicom_bytes(const uint8_t* data, size_t size, const std::string& name,
+                           const std::string& dir) {
+    const ReadAt read = [&](uint64_t pos, uint8_t* buf, size_t n) -> size_t {
+        if (pos >= size) return 0;
+        const size_t k = std::min<uint64_t>(n, size - pos);
+        std::memcpy(buf, data + pos, k);
+        return k;
+    };
+    return walk(read, size, name, dir);
 }
 
 }  // namespace lacuna::io

@@ -566,6 +566,88 @@ TEST(IoDicomFolder, HugeLengthAfterThePixelDataIsAnError) {
         << msg;
 }
 
+// A 12-byte file without the preamble and "DICM" whose first element, (0002,0000) in implicit
+// VR, says 4.2 GB made GDCM's scanner (FileMetaInformation::ReadCompat) allocate it (found by
+// fuzz_dicom_dir). GDCM reads such files from byte 0, guessing the encoding from the first
+// tag; the walk does the same, so a length past the end is an error before GDCM sees it, in
+// each of GDCM's guesses.
+TEST(IoDicomFolder, HugeLengthInAFileWithoutPreambleIsAnError) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    struct Case {
+        const char* what;
+        std::vector<uint8_t> bytes;
+        const char* expect;
+    };
+    const std::vector<Case> cases{
+        {"the finding: meta group, implicit VR",
+         {0x02, 0, 0, 0, 0, 0, 0xe5, 0xfa, 0, 0, 0, 0},
+         "element (0002,0000) says 4209311744 bytes, 4 are left in the file"},
+        {"meta group, explicit VR, long form",
+         {0x02, 0, 0x01, 0, 'O', 'B', 0, 0, 0, 0, 0, 0xf0, 1, 2, 3, 4},
+         "element (0002,0001) says 4026531840 bytes, 4 are left"},
+        {"group 0008, implicit VR",
+         {0x08, 0, 0x16, 0, 0xff, 0xff, 0xff, 0x7f, 1, 2},
+         "element (0008,0016) says 2147483647 bytes, 2 are left"},
+        {"group 0008, explicit VR, after a good element",
+         {0x08, 0, 0x05, 0, 'C', 'S', 2, 0, 'I', 'R', 0x08, 0, 0x06, 0, 'U', 'N', 0, 0, 0, 0,
+          0, 0x80},
+         "element (0008,0006) says 2147483648 bytes, 0 are left"},
+        {"ACR-NEMA big endian, explicit VR",
+         {0, 0x08, 0, 0x16, 'O', 'W', 0, 0, 0x40, 0, 0, 0, 9, 9},
+         "element (0008,0016) says 1073741824 bytes, 2 are left"},
+        {"a private creator first, implicit VR",
+         {0x09, 0, 0x10, 0, 0, 0, 0, 0x60, 'x', 'y'},
+         "element (0009,0010) says 1610612736 bytes, 2 are left"},
+    };
+    for (const Case& c : cases) {
+        test::write_bytes(s + "/junk.dcm", c.bytes);
+        std::string msg = read_error(s);
+        EXPECT_NE(msg.find("junk.dcm: " + std::string(c.expect)), std::string::npos)
+            << c.what << ": " << msg;
+        EXPECT_NE(msg.find("without a DICOM preamble"), std::string::npos) << c.what << ": " << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << c.what << ": " << msg;
+        // The same bytes under a name that does not say DICOM: GDCM would read them all the
+        // same, so they are walked all the same.
+        fs::rename(s + "/junk.dcm", s + "/junk");
+        msg = read_error(s);
+        EXPECT_NE(msg.find("junk: " + std::string(c.expect)), std::string::npos)
+            << c.what << ": " << msg;
+        fs::remove(s + "/junk");
+    }
+    EXPECT_EQ(read_volume(s).dims(), (Vec3i{8, 8, 3}));
+}
+
+// Files GDCM does not take for DICOM (its guess from the first tag fails) are still ignored,
+// whatever their lengths would say, and preamble-less slices that are whole are still read.
+TEST(IoDicomFolder, FilesWithoutPreambleAreWalkedOnlyWhenGdcmWouldReadThem) {
+    ScratchDir dir;
+    const Volume v = test::pattern_volume({8, 8, 3}, VoxelType::Int16);
+    write_volume(dir.file("s") + "/", v);
+    const std::string s = dir.file("s");
+    test::write_text(s + "/notes.txt", "Patient scanned twice; the second series is in s2.\n");
+    const uint8_t png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H'};
+    test::write_bytes(s + "/thumb.png", png, sizeof png);
+    test::write_bytes(s + "/tiny", png, 3);
+    EXPECT_TRUE(test::same_voxels(read_volume(s), v));
+    // A slice with its 128-byte preamble and "DICM" cut off starts with its meta group, which
+    // GDCM reads from byte 0: still the same volume.
+    const std::string first = s + "/slice_00000.dcm";
+    const std::vector<uint8_t> bytes = test::file_bytes(first);
+    ASSERT_GT(bytes.size(), 132u);
+    test::write_bytes(first, bytes.data() + 132, bytes.size() - 132);
+    EXPECT_TRUE(test::same_voxels(read_volume(s), v));
+    // ... and its Pixel Data length is checked there too.
+    std::vector<uint8_t> cut(bytes.begin() + 132, bytes.end());
+    const uint32_t huge = 0x30000000;
+    std::memcpy(&cut[pixel_length_offset(cut)], &huge, 4);
+    test::write_bytes(first, cut);
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("slice_00000.dcm: element (7FE0,0010) says 805306368 bytes"),
+              std::string::npos)
+        << msg;
+}
+
 TEST(IoDicomFolder, ShortPixelDataIsAnErrorNotAShortSlice) {
     ScratchDir dir;
     const std::string s = write_series(dir, "s", 3);
