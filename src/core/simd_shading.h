@@ -661,8 +661,9 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
     n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
     aa = _mm256_load_ps(s.a);                                                         \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
-    if constexpr (kLeap) lscale = leap_scale8(vdt, dx, dy, dz);
-    __m256 lscale = _mm256_setzero_ps();  // leaping: 4 / (dt * max|dir|), per lane
+    if constexpr (kLeap) leap_inverse8(dx, dy, dz, linv);
+    LeapInverse linv;  // leaping: 1 / dir per lane
+    const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
     int active_mask, waiting = 0;
     LACUNA_LOAD_LANES
     int need;
@@ -675,7 +676,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
         const __m256 z = _mm256_add_ps(oz, _mm256_mul_ps(t, dz));
         const __m256 v = trilinear8(g, data, x, y, z);
         __m256i taken = valid, adv = _mm256_set1_epi32(1);
-        if constexpr (kLeap) leap8(g, x, y, z, valid, lscale, taken, adv);
+        if constexpr (kLeap) leap8(g, x, y, z, valid, inv_dt, linv, taken, adv);
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
         const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), taken);
