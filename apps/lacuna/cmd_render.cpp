@@ -2,18 +2,21 @@
 // --tf-animate, a sequence while the TF moves between two TFs (bitfield paper, Section 4.5),
 // reporting per structure the time from a TF change to ready-to-render.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "cli_common.h"
-#include "feature_args.h"
-#include "render_slice.h"
 #include "core/parallel.h"
+#include "feature_args.h"
+#include "frame_flags.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
-#include "lacuna/renderer.h"
+#include "lacuna/frame_spec.h"
+#include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
+#include "render_slice.h"
 #include "segments_cli.h"
 
 namespace lacuna::cli {
@@ -85,12 +88,31 @@ std::string frame_path(const std::string& out, int i) {
     return (p.parent_path() / (p.stem().string() + num + p.extension().string())).string();
 }
 
+// The frame the flags describe (the strings become a FrameSpec here; its ranges are checked by
+// lacuna::validate, whose fields frame_flags.cpp translates back to flags).
 struct Setup {
-    RenderOptions ro;
-    AccelOptions ao;
-    OrbitParams op;
-    int w = 0, h = 0;
+    FrameSpec spec;
+    AccelOptions ao;  // the octree and bitfield flags, for structure_of()
 };
+
+// The structure `name` names for the renderer of `spec` ("auto": the renderer's default; the
+// segment renderer's "bitfield" is the label bitfield octree, the slicer's "boxes" the growing
+// boxes).
+Structure structure_from(const std::string& name, const RenderArgs& a, const Setup& s) {
+    switch (s.spec.renderer) {
+        case Renderer::Segments:
+            if (name == "auto" || name == "bitfield") return structure::LabelOctree{a.leaf, a.bits};
+            break;
+        case Renderer::Slicer:
+            if (name == "auto") return structure::None{};
+            if (name == "boxes") return structure::GrowingBoxes{a.slice.coalesce, a.slice.coalesce_edge};
+            break;
+        case Renderer::RayMarcher:
+            if (name == "boxes") return structure::GrowingBoxes{a.slice.coalesce, a.slice.coalesce_edge};
+            break;
+    }
+    return structure_of(parse_accel(name), s.ao);
+}
 
 Setup validate(RenderArgs& a) {
     if (!a.view.empty()) {
@@ -114,95 +136,95 @@ Setup validate(RenderArgs& a) {
     if (a.out.empty()) throw Error("render", "--out", "expected an output .png file");
     check_output_path(a.out, ".png");
     if (!a.heatmap.empty()) check_output_path(a.heatmap, ".png");
-    Setup s;
-    s.w = a.width > 0 ? a.width : a.size;
-    s.h = a.height > 0 ? a.height : a.size;
-    if (s.w < 1 || s.h < 1 || s.w > 16384 || s.h > 16384)
-        throw Error("--size", "image size", "expected 1..16384 pixels per side");
-    if (!(a.step > 0.f && a.step <= 64.f)) throw Error("--step", "step", "expected 0 < step <= 64");
-    if (!(a.ert > 0.f && a.ert <= 1.f)) throw Error("--ert", "threshold", "expected 0 < ert <= 1");
-    if (!(a.zoom > 0.f && a.zoom <= 1000.f)) throw Error("--zoom", "zoom", "expected 0 < zoom <= 1000");
-    if (!(a.fov > 0.f && a.fov < 180.f)) throw Error("--fov", "field of view", "expected 0 < degrees < 180");
-    if (!std::isfinite(a.azimuth) || !std::isfinite(a.elevation))
-        throw Error("--azimuth/--elevation", "angle", "expected finite degrees");
     if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
     if (a.repeat < 1 || a.repeat > 100000) throw Error("--repeat", "frames", "expected 1..100000");
-    s.ro.step = a.step;
-    s.ro.interpolation = parse_interpolation(a.interpolation);
-    s.ao.interpolation = s.ro.interpolation;
-    s.ro.ert = a.ert >= 1.f ? 2.f : a.ert;  // 1 means off: opacity never reaches 2
-    s.ro.threads = a.threads;
-    s.ro.background = parse_rgb(a.background);
-    s.ro.count_samples = !a.heatmap.empty();
-    s.ro.features = parse_features(a.features);
+    check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
     if (!a.tf_animate.empty() && !a.features.tf_back.empty())
         throw Error("--tf-back", "transfer function", "not supported with --tf-animate");
+    if (a.segments.active() && !a.tf_animate.empty())
+        throw Error("--tf-animate", "segments", "not available with --labels/--segments");
+    if (a.segments.active() && a.slice.renderer == "slice")
+        throw Error("--renderer", "segments", "segments are rendered by the ray marcher only");
+
+    Setup s;
+    FrameSpec& f = s.spec;
+    f.renderer = a.segments.active()           ? Renderer::Segments
+                 : a.slice.renderer == "slice" ? Renderer::Slicer
+                                               : Renderer::RayMarcher;
+    f.width = a.width > 0 ? a.width : a.size;
+    f.height = a.height > 0 ? a.height : a.size;
+    f.sampling.step = a.step;
+    // --ert 1 means off (nullopt); any other value is checked by validate().
+    f.sampling.early_termination = a.ert == 1.f ? std::nullopt : std::optional<float>(a.ert);
+    f.sampling.interpolation = parse_interpolation(a.interpolation);
+    f.background = parse_rgb(a.background);
+    f.count_samples = !a.heatmap.empty();
+    f.features = parse_features(a.features);
+    f.two_tfs = !a.features.tf_back.empty();
+    f.camera.orbit.azimuth_deg = a.azimuth;
+    f.camera.orbit.elevation_deg = a.elevation;
+    f.camera.orbit.zoom = a.zoom;
+    f.camera.orbit.fov_y_deg = a.fov;
+    f.camera.orbit.projection = a.ortho ? Projection::Orthographic : Projection::Perspective;
+    f.slicer.occlusion = a.slice.occlusion;
+    f.slicer.occlusion_threshold = a.slice.occlusion_threshold;
+    f.slicer.occlusion_map = a.slice.occlusion_map;
+    if (a.segments.active()) {
+        f.segments.mode = parse_segment_mode(a.segments.mode.empty() ? "mask" : a.segments.mode);
+        f.segments.tint = a.segments.tint;
+    }
     s.ao.leaf_cells = a.leaf;
     s.ao.bitfield_bits = a.bits;
     s.ao.initial_level = a.initial_level;
     s.ao.bidirectional = !a.top_down;
-    s.ao.threads = a.threads;
-    s.op.azimuth_deg = a.azimuth;
-    s.op.elevation_deg = a.elevation;
-    s.op.zoom = a.zoom;
-    s.op.fov_y_deg = a.fov;
-    s.op.projection = a.ortho ? Projection::Orthographic : Projection::Perspective;
+    // --tf-animate takes a list of structures (render_animation); the frame carries the first.
+    const std::string first = a.accel.substr(0, a.accel.find(','));
+    f.structure = first == "all" ? Structure{structure::None{}} : structure_from(first, a, s);
+    validate_flags(f);
     return s;
 }
 
-std::unique_ptr<Accel> build_accel(AccelKind k, const Volume& vol, const AccelOptions& ao) {
-    Progress progress("building " + to_string(k));
-    auto accel = make_accel(k, vol, ao);
-    progress.done();
-    return accel;
-}
-
-void print_accel(AccelKind k, const Accel& accel) {
-    if (k == AccelKind::None) return;
-    const AccelStats& st = accel.stats();
+void print_accel(const Structure& st, const AccelStats& stats) {
+    const std::optional<AccelKind> k = accel_kind(st);
+    if (!k || *k == AccelKind::None) return;
     std::printf("accel %s: build %.1f ms, TF update %.3f ms, refine %.3f ms, %zu nodes, %.2f MiB\n",
-                to_string(k).c_str(), st.build_seconds * 1e3, st.tf_update_seconds * 1e3,
-                st.refine_seconds * 1e3, st.nodes, double(st.bytes) / (1 << 20));
+                to_string(*k).c_str(), stats.build_seconds * 1e3, stats.tf_update_seconds * 1e3,
+                stats.refine_seconds * 1e3, stats.nodes, double(stats.bytes) / (1 << 20));
 }
 
 void render_one(const RenderArgs& a, const Setup& s) {
-    const AccelKind kind = parse_accel(a.accel);
+    const FrameSpec& spec = s.spec;
     const TransferFunction tf = resolve_transfer_function(a.tf);
-    const Volume vol = load_volume(a.volume);
-    const TransferLut lut = discretise(tf, vol.vis_range());
-    auto accel = build_accel(kind, vol, s.ao);
-    RayMarcher marcher(vol);
-    marcher.set_transfer_function(lut);
-    if (a.features.tf_back.empty()) {
-        accel->set_transfer_function(lut);
-    } else {
-        // Two TFs: the structure skips only where both are transparent.
-        const TransferLut back = discretise(resolve_transfer_function(a.features.tf_back), vol.vis_range());
-        marcher.set_back_transfer_function(back);
-        accel->set_transfer_function(union_lut(lut, back));
-    }
-    if (!a.no_refine) accel->refine();  // the structure's finer per-TF level, before the frame
-    marcher.set_accel(accel.get());
-    const Camera cam = Camera::orbit(marcher.bounds(), s.op, s.w, s.h);
+    std::optional<TransferFunction> back;
+    if (spec.two_tfs) back = resolve_transfer_function(a.features.tf_back);
+    Session session(load_volume(a.volume), a.threads);
+    session.set_transfer_function(tf);
+    // Two TFs: the structure skips only where both are transparent (the session gives it
+    // their union).
+    if (back) session.set_back_transfer_function(back);
+    Progress progress("building " + structure_name(spec.structure));
+    session.prepare(spec);
+    progress.done();
+    if (!a.no_refine) session.refine();  // the structure's finer per-TF level, before the frame
     // --repeat N: frame 1 warms caches, pages and threads (as the VTK peer's warm-up render);
     // the reported time is the median of the N - 1 frames after it (every frame gives the same
     // bytes: the renderer is deterministic).
-    RenderResult r = marcher.render(cam, s.ro);
+    FrameResult r = session.render(spec);
     const double first_ms = r.stats.seconds * 1e3;
     if (a.repeat > 1) {
         std::vector<RenderStats> warm;
-        for (int f = 1; f < a.repeat; ++f) warm.push_back(marcher.render(cam, s.ro).stats);
+        for (int f = 1; f < a.repeat; ++f) warm.push_back(session.render(spec).stats);
         std::sort(warm.begin(), warm.end(),
                   [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
         r.stats = warm[warm.size() / 2];
     }
     write_png(a.out, r.image);
-    if (!a.heatmap.empty()) write_png(a.heatmap, heatmap(r.sample_counts, s.w, s.h));
-    std::printf("%s: %dx%d %s, tf %s, accel %s, %d threads\n", a.volume.path.c_str(), s.w, s.h,
-                a.ortho ? "orthographic" : "perspective", tf.name.c_str(), a.accel.c_str(),
-                resolve_threads(a.threads));
-    print_accel(kind, *accel);
-    if (const std::string f = describe(s.ro.features); !f.empty()) std::printf("features: %s\n", f.c_str());
+    if (!a.heatmap.empty()) write_png(a.heatmap, heatmap(r.sample_counts, spec.width, spec.height));
+    std::printf("%s: %dx%d %s, tf %s, accel %s, %d threads\n", a.volume.path.c_str(), spec.width,
+                spec.height, a.ortho ? "orthographic" : "perspective", tf.name.c_str(),
+                a.accel.c_str(), resolve_threads(a.threads));
+    if (r.structure) print_accel(spec.structure, *r.structure);
+    if (const std::string f = describe(spec.features); !f.empty()) std::printf("features: %s\n", f.c_str());
     if (r.stats.gradient_volume_bytes)
         std::printf("gradient volume: %.2f MiB, computed in %.1f ms\n",
                     double(r.stats.gradient_volume_bytes) / (1 << 20), r.stats.gradient_volume_seconds * 1e3);
@@ -221,35 +243,39 @@ void render_one(const RenderArgs& a, const Setup& s) {
 }
 
 // The TF animation: frames with the TF interpolated from A to B. For every structure the TF
-// change (structure update + LUT) is timed separately from the frame.
+// change (LUT + structure update, through the session) is timed separately from the frame.
 void render_animation(const RenderArgs& a, const Setup& s) {
     if (a.tf_animate.size() != 2)
         throw Error("--tf-animate", "transfer functions", "expected two: A B");
     const std::vector<AccelKind> kinds = parse_accels(a.accel);
     const TransferFunction tf_a = resolve_transfer_function(a.tf_animate[0]);
     const TransferFunction tf_b = resolve_transfer_function(a.tf_animate[1]);
-    const Volume vol = load_volume(a.volume);
+    Session session(load_volume(a.volume), a.threads);
     const bool write_frames = kinds.size() == 1;
     std::printf("%s: TF animation %s -> %s, %d frames at %dx%d, %d threads\n", a.volume.path.c_str(),
-                tf_a.name.c_str(), tf_b.name.c_str(), a.frames, s.w, s.h, resolve_threads(a.threads));
+                tf_a.name.c_str(), tf_b.name.c_str(), a.frames, s.spec.width, s.spec.height,
+                resolve_threads(a.threads));
     std::printf("%-10s %12s %16s %16s %14s %12s\n", "accel", "build [ms]", "TF change [ms]",
                 "TF change max", "frame [ms]", "samples/ray");
     for (AccelKind k : kinds) {
-        auto accel = build_accel(k, vol, s.ao);
-        RayMarcher marcher(vol);
-        marcher.set_accel(accel.get());
-        const Camera cam = Camera::orbit(marcher.bounds(), s.op, s.w, s.h);
+        FrameSpec spec = s.spec;
+        spec.structure = structure_of(k, s.ao);
+        // One structure at a time (memory), built holding B so that frame 0 (A) is a TF change.
+        session.drop_structures();
+        session.set_transfer_function(tf_b);
+        Progress building("building " + to_string(k));
+        const double build_ms = session.prepare(spec).structure->build_seconds * 1e3;
+        building.done();
         double tf_sum = 0, tf_max = 0, frame_sum = 0, spr_sum = 0;
         Progress progress("animating " + to_string(k));
         for (int f = 0; f < a.frames; ++f) {
             const float w = float(f) / float(a.frames - 1);
-            const TransferLut lut = discretise(lerp(tf_a, tf_b, w), vol.vis_range());
             const auto t0 = std::chrono::steady_clock::now();
-            accel->set_transfer_function(lut);
-            marcher.set_transfer_function(lut);
+            session.set_transfer_function(lerp(tf_a, tf_b, w));
+            session.prepare(spec);
             const double tf_change =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            const RenderResult r = marcher.render(cam, s.ro);
+            const FrameResult r = session.render(spec);
             if (write_frames) write_png(frame_path(a.out, f), r.image);
             tf_sum += tf_change;
             tf_max = std::max(tf_max, tf_change);
@@ -258,9 +284,9 @@ void render_animation(const RenderArgs& a, const Setup& s) {
             progress.update(double(f + 1) / a.frames);
         }
         progress.done();
-        std::printf("%-10s %12.1f %16.3f %16.3f %14.1f %12.1f\n", to_string(k).c_str(),
-                    accel->stats().build_seconds * 1e3, tf_sum / a.frames * 1e3, tf_max * 1e3,
-                    frame_sum / a.frames * 1e3, spr_sum / a.frames);
+        std::printf("%-10s %12.1f %16.3f %16.3f %14.1f %12.1f\n", to_string(k).c_str(), build_ms,
+                    tf_sum / a.frames * 1e3, tf_max * 1e3, frame_sum / a.frames * 1e3,
+                    spr_sum / a.frames);
     }
     if (write_frames)
         std::printf("wrote %s .. %s\n", frame_path(a.out, 0).c_str(),
@@ -269,38 +295,28 @@ void render_animation(const RenderArgs& a, const Setup& s) {
 
 void run(RenderArgs& a) {
     const Setup s = validate(a);
-    // `auto` per renderer: the segment renderer's fastest exact structure is the label bitfield
-    // octree; the slicer slices the whole volume (its structures are the papers' boxes, chosen
-    // explicitly); the ray marcher takes default_accel().
-    if (a.accel == "auto") {
-        if (a.segments.active()) a.accel = "bitfield";
-        else if (a.slice.renderer == "slice") a.accel = "none";
+    // What `auto` resolved to, for the reports: the segment renderer's fastest exact structure is
+    // the label bitfield octree; the slicer slices the whole volume (its structures are the
+    // papers' boxes, chosen explicitly); the ray marcher takes default_accel().
+    const std::string accel = a.accel != "auto"                       ? a.accel
+                              : s.spec.renderer == Renderer::Segments ? "bitfield"
+                              : s.spec.renderer == Renderer::Slicer   ? "none"
+                                                                      : a.accel;
+    switch (s.spec.renderer) {
+        case Renderer::Segments:
+            render_segments(a.segments, SegmentFrame{a.volume, a.tf, accel, a.threads, s.spec,
+                                                     a.out, a.heatmap});
+            return;
+        case Renderer::Slicer:
+            render_slice({a.volume, a.tf, accel, a.out, a.threads, s.spec});
+            return;
+        case Renderer::RayMarcher:
+            if (a.tf_animate.empty())
+                render_one(a, s);
+            else
+                render_animation(a, s);
+            return;
     }
-    check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
-    // Shading, lights, clipping, blend modes and jitter live in the ray marcher's feature kernel.
-    if (s.ro.features.any() || !a.features.tf_back.empty()) {
-        if (a.segments.active())
-            throw Error("--shading/--clip/--blend", "segments", "not available with --labels/--segments");
-        if (a.slice.renderer == "slice")
-            throw Error("--renderer", "slice", "shading, lights, clipping, blend modes and jitter need the ray marcher");
-    }
-    if (a.segments.active()) {
-        if (!a.tf_animate.empty())
-            throw Error("--tf-animate", "segments", "not available with --labels/--segments");
-        if (a.slice.renderer == "slice")
-            throw Error("--renderer", "segments", "segments are rendered by the ray marcher only");
-        render_segments(a.segments, SegmentFrame{a.volume, a.tf, a.accel, a.leaf, a.bits, s.ro,
-                                                 s.op, s.w, s.h, a.out, a.heatmap});
-        return;
-    }
-    if (a.slice.renderer == "slice") {
-        render_slice(a.slice, {a.volume, a.tf, a.accel, a.out, s.ao, s.ro, s.op, s.w, s.h});
-        return;
-    }
-    if (a.tf_animate.empty())
-        render_one(a, s);
-    else
-        render_animation(a, s);
 }
 
 }  // namespace

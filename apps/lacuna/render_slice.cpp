@@ -5,8 +5,7 @@
 #include "core/parallel.h"
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
-#include "slice/box_sources.h"
-#include "slice/slice_renderer.h"
+#include "lacuna/session.h"
 
 namespace lacuna::cli {
 
@@ -51,53 +50,34 @@ void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap) {
         throw Error("--occlusion-map", "map size", "expected 1..4096 cells");
 }
 
-void render_slice(const SliceCliArgs& a, const SliceRenderJob& job) {
+void render_slice(const SliceRenderJob& job) {
     const TransferFunction tf = resolve_transfer_function(job.tf);
-    const Volume vol = load_volume(job.volume);
-    const TransferLut lut = discretise(tf, vol.vis_range());
+    Session session(load_volume(job.volume), job.threads);
+    session.set_transfer_function(tf);
     Progress progress("building " + job.accel);
-    BoxesOptions boxes;
-    boxes.coalesce = a.coalesce;
-    boxes.coalesce_edge = a.coalesce_edge;
-    auto source = make_box_source(job.accel, vol, job.accel_options, boxes);
-    source->set_transfer_function(lut);
+    session.prepare(job.spec);
     progress.done();
-    SliceRenderer slicer(vol);
-    slicer.set_transfer_function(lut);
-    if (job.accel != "none") slicer.set_box_source(source.get());
-    SliceOptions o;
-    o.step = job.render.step;
-    o.ert = job.render.ert;
-    o.threads = job.render.threads;
-    o.background = job.render.background;
-    o.nearest = job.render.interpolation == Interpolation::Nearest;
-    if (a.occlusion) {
-        o.occlusion.mode = OcclusionMode::CullClip;
-        o.occlusion.threshold = a.occlusion_threshold;
-        o.occlusion.map_size = a.occlusion_map;
-    }
-    const Camera cam = Camera::orbit(slicer.bounds(), job.orbit, job.width, job.height);
-    const SliceResult r = slicer.render(cam, o);
+    const FrameResult r = session.render(job.spec);
     write_png(job.out, r.image);
-    const SliceStats& s = r.stats;
+    const SlicerFrameStats& s = *r.slicer;
+    const FrameSpec& f = job.spec;
     std::printf("%s: %dx%d %s, tf %s, slice renderer, accel %s, %d threads\n",
-                job.volume.path.c_str(), job.width, job.height,
-                job.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
-                tf.name.c_str(), job.accel.c_str(), resolve_threads(job.render.threads));
+                job.volume.path.c_str(), f.width, f.height,
+                f.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
+                tf.name.c_str(), job.accel.c_str(), resolve_threads(job.threads));
     std::printf("render time %.1f ms (polygon set-up %.1f%% of CPU time, %.1f%% of wall time), "
                 "%llu boxes, %llu polygons, %.1f Msamples/s\n",
-                s.seconds * 1e3, 100 * s.setup_cpu_fraction(), 100 * s.setup_fraction(),
-                (unsigned long long)s.boxes,
-                (unsigned long long)s.polygons, s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0);
-    if (a.occlusion)
+                r.stats.seconds * 1e3, 100 * s.setup_cpu_fraction, 100 * s.setup_fraction,
+                (unsigned long long)s.boxes, (unsigned long long)s.polygons,
+                r.stats.seconds > 0 ? double(r.stats.samples) / r.stats.seconds * 1e-6 : 0);
+    if (f.slicer.occlusion)
         std::printf("occlusion (threshold %.3g, map %dx%d): %d/%d map updates, %llu boxes culled, "
                     "%llu clipped, %.1f%% of non-empty voxels skipped (%.1f%% culled, %.1f%% "
                     "clipped), %.1f ms\n",
-                    a.occlusion_threshold, a.occlusion_map, a.occlusion_map, s.map_updates,
-                    s.desired_updates, (unsigned long long)s.boxes_culled,
-                    (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction(),
-                    100 * s.culled_fraction(), 100 * s.clipped_fraction(),
-                    s.occlusion_seconds * 1e3);
+                    f.slicer.occlusion_threshold, f.slicer.occlusion_map, f.slicer.occlusion_map,
+                    s.map_updates, s.desired_updates, (unsigned long long)s.boxes_culled,
+                    (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction,
+                    100 * s.culled_fraction, 100 * s.clipped_fraction, s.occlusion_seconds * 1e3);
     std::printf("wrote %s\n", job.out.c_str());
 }
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "cli_common.h"
-#include "lacuna/renderer.h"
+#include "lacuna/frame_spec.h"
 #include "slice/growing_boxes.h"
 
 namespace lacuna::cli {
@@ -23,14 +23,13 @@ void add_slice_options(CLI::App& cmd, SliceCliArgs& a);
 // `heatmap`: whether --tf-animate / --heatmap were given (the slicer has neither).
 void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap);
 
+// One slicer frame through lacuna::Session: the spec (renderer Slicer) and what the report names.
 struct SliceRenderJob {
     VolumeArgs volume;
-    std::string tf, accel, out;
-    AccelOptions accel_options;
-    RenderOptions render;  // step, ert, threads, background
-    OrbitParams orbit;
-    int width = 0, height = 0;
+    std::string tf, accel, out;  // accel: the --accel name, for the report
+    int threads = 0;
+    FrameSpec spec;
 };
-void render_slice(const SliceCliArgs& a, const SliceRenderJob& job);
+void render_slice(const SliceRenderJob& job);
 
 }  // namespace lacuna::cli

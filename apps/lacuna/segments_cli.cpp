@@ -6,6 +6,7 @@
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
 #include "lacuna/segments.h"
+#include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
 
 namespace lacuna::cli {
@@ -28,69 +29,43 @@ void add_segment_args(CLI::App& cmd, SegmentArgs& a) {
 }
 
 void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
-    SegmentOptions so;
-    so.mode = parse_segment_mode(a.mode.empty() ? "mask" : a.mode);
-    so.tint = a.tint;
-    so.leaf_cells = f.leaf;
-    so.bitfield_bits = f.bits;
-    // bitfield: the label bitfield octree (labels + intensity bins); any other structure skips on
-    // the intensity alone (mask mode).
-    const AccelKind kind = parse_accel(f.accel);
-    so.skip = kind == AccelKind::Bitfield;
-    const bool masked = so.mode == SegmentMode::Masked;
-    if (!masked && kind != AccelKind::None && kind != AccelKind::Bitfield)
-        throw Error("--accel", "structure",
-                    "the label volume alone takes 'none' or 'bitfield' (the label bitfield "
-                    "octree), got '" + f.accel + "'");
+    FrameSpec spec = f.spec;
+    const bool masked = spec.segments.mode == SegmentMode::Masked;
+    const bool octree = std::holds_alternative<structure::LabelOctree>(spec.structure);
     if (masked && a.labels.empty())
         throw Error("--segments", "mode", "mask mode needs --labels FILE");
     if (masked && f.tf.empty()) throw Error("render", "--tf", "mask mode needs a transfer function");
     std::optional<TransferFunction> tf;
     if (masked) tf = resolve_transfer_function(f.tf);
-    const Volume vol = load_volume(f.volume);
-    Volume label_store;
-    if (!a.labels.empty()) {
-        VolumeArgs la;
-        la.path = a.labels;
-        label_store = load_volume(la);
+    // Labels mode reads the label volume alone: --labels, or else the VOLUME argument.
+    VolumeArgs la;
+    la.path = a.labels;
+    Session session(load_volume(masked || a.labels.empty() ? f.volume : la), f.threads);
+    if (masked) {
+        session.set_labels(load_volume(la));
+        session.set_transfer_function(*tf);
     }
-    const Volume& labels = a.labels.empty() ? vol : label_store;
-    LabelTable table = a.style.empty() ? default_label_table(labels)
-                                       : load_label_table(a.style, labels);
+    LabelTable table = a.style.empty() ? session.label_table()
+                                       : load_label_table(a.style, session.label_volume());
     for (const std::string& s : a.show) set_label_visibility(table, s, true, "--show");
     for (const std::string& s : a.hide) set_label_visibility(table, s, false, "--hide");
+    spec.segments.labels = table;
     Progress progress("building label octree");
-    SegmentRenderer seg(masked ? &vol : nullptr, labels, so);
+    session.prepare(spec);
     progress.done();
-    std::unique_ptr<Accel> accel;
-    if (masked) {
-        const TransferLut lut = discretise(*tf, vol.vis_range());
-        seg.set_transfer_function(lut);
-        if (!so.skip && kind != AccelKind::None) {
-            AccelOptions ao;
-            ao.leaf_cells = f.leaf;
-            ao.bitfield_bits = f.bits;
-            ao.threads = f.ro.threads;
-            accel = make_accel(kind, vol, ao);
-            accel->set_transfer_function(lut);
-            seg.set_accel(accel.get());
-        }
-    }
-    seg.set_labels(table);
-    const Camera cam = Camera::orbit(seg.bounds(), f.op, f.w, f.h);
-    const RenderResult r = seg.render(cam, f.ro);
+    const FrameResult r = session.render(spec);
     write_png(f.out, r.image);
-    if (!f.heatmap.empty()) write_png(f.heatmap, heatmap(r.sample_counts, f.w, f.h));
+    if (!f.heatmap.empty()) write_png(f.heatmap, heatmap(r.sample_counts, spec.width, spec.height));
     int shown = 0;
     for (const auto& s : table.styles) shown += s.visible && s.opacity > 0.f;
     std::printf("%s: %dx%d, segments %s, %d of %d labels visible, accel %s, %d threads\n",
-                f.volume.path.c_str(), f.w, f.h, to_string(so.mode).c_str(), shown,
-                table.size(), so.skip ? "label bitfield octree" : f.accel.c_str(),
-                resolve_threads(f.ro.threads));
-    if (so.skip)
+                f.volume.path.c_str(), spec.width, spec.height, to_string(spec.segments.mode).c_str(),
+                shown, table.size(), octree ? "label bitfield octree" : f.accel.c_str(),
+                resolve_threads(f.threads));
+    if (octree)
         std::printf("label octree: build %.1f ms, %d bits per node, %.2f MiB, label change %.3f ms\n",
-                    seg.stats().build_seconds * 1e3, 64 * seg.stats().label_words,
-                    double(seg.stats().bytes) / (1 << 20), seg.stats().label_update_seconds * 1e3);
+                    r.segments->build_seconds * 1e3, 64 * r.segments->label_words,
+                    double(r.segments->bytes) / (1 << 20), r.segments->label_update_seconds * 1e3);
     std::printf("render time %.1f ms, %.1f samples/ray\n", r.stats.seconds * 1e3,
                 r.stats.samples_per_ray());
     std::printf("wrote %s\n", f.out.c_str());

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "cli_common.h"
-#include "lacuna/renderer.h"
+#include "lacuna/frame_spec.h"
 
 namespace lacuna::cli {
 
@@ -20,15 +20,14 @@ struct SegmentArgs {
 };
 void add_segment_args(CLI::App& cmd, SegmentArgs& a);
 
-// Everything render_one needs besides the segment flags.
+// Everything the segments frame needs besides the segment flags: the spec (renderer Segments,
+// its mode, structure and tint already set) and what the report names.
 struct SegmentFrame {
     const VolumeArgs& volume;
-    const std::string& tf;       // mask mode
-    const std::string& accel;    // "none" or "bitfield"
-    int leaf = 8, bits = 64;
-    RenderOptions ro;
-    OrbitParams op;
-    int w = 0, h = 0;
+    const std::string& tf;  // mask mode
+    std::string accel;      // the --accel name, for the report
+    int threads = 0;
+    FrameSpec spec;
     std::string out, heatmap;
 };
 void render_segments(const SegmentArgs& a, const SegmentFrame& f);

@@ -1,0 +1,63 @@
+#include "frame_flags.h"
+
+#include <utility>
+
+namespace lacuna::cli {
+
+namespace {
+
+// Field prefixes of FrameSpec and the flag that sets them.
+constexpr std::pair<const char*, const char*> kFlags[] = {
+    {"width", "--size"},
+    {"height", "--size"},
+    {"camera.orbit.zoom", "--zoom"},
+    {"camera.orbit.fov_y_deg", "--fov"},
+    {"camera.orbit", "--azimuth/--elevation"},
+    {"background", "--background"},
+    {"sampling.step", "--step"},
+    {"sampling.early_termination", "--ert"},
+    {"sampling.interpolation", "--interpolation"},
+    {"structure.octree.leaf_cells", "--leaf"},
+    {"structure.leaf_cells", "--leaf"},
+    {"structure.bits", "--bits"},
+    {"structure", "--accel"},
+    {"features.shading", "--shading"},
+    {"features.gradient_opacity", "--gradient-opacity"},
+    {"features.shadows", "--shadows"},
+    {"features.clip_planes", "--clip"},
+    {"features.crop", "--crop"},
+    {"features.blend", "--blend"},
+    {"features.jitter", "--jitter"},
+    {"features", "--shading/--light/--clip"},
+    {"two_tfs", "--tf-back"},
+    {"count_samples", "--heatmap"},
+    {"slicer.occlusion_threshold", "--occlusion-threshold"},
+    {"slicer.occlusion_map", "--occlusion-map"},
+    {"slicer.occlusion", "--occlusion"},
+    {"segments.tint", "--label-tint"},
+    {"segments", "--segments"},
+};
+
+}  // namespace
+
+std::string flag_of_field(const std::string& field) {
+    size_t best = 0;
+    std::string flag = "render";
+    for (const auto& [prefix, f] : kFlags) {
+        const std::string p = prefix;
+        const bool match = field.compare(0, p.size(), p) == 0 &&
+                           (field.size() == p.size() || field[p.size()] == '.');
+        if (match && p.size() > best) best = p.size(), flag = f;
+    }
+    return flag;
+}
+
+void validate_flags(const FrameSpec& spec) {
+    try {
+        validate(spec);
+    } catch (const FrameError& e) {
+        throw Error(flag_of_field(e.field()), e.field(), e.expected());
+    }
+}
+
+}  // namespace lacuna::cli

@@ -1,0 +1,17 @@
+// The CLI's edge for FrameSpec (lacuna/frame_spec.h): the library's errors name FrameSpec fields
+// ("sampling.step"); the user typed flags ("--step"). One table translates the one to the other,
+// so no library error has to know a flag.
+#pragma once
+#include <string>
+
+#include "lacuna/frame_spec.h"
+
+namespace lacuna::cli {
+
+// The `lacuna render` flag that sets FrameSpec field `field` (the longest listed prefix wins:
+// "structure.octree.leaf_cells" -> "--leaf", "structure" -> "--accel").
+std::string flag_of_field(const std::string& field);
+// validate(spec), its FrameError rethrown as lacuna::Error(flag, field, expected).
+void validate_flags(const FrameSpec& spec);
+
+}  // namespace lacuna::cli

@@ -1,0 +1,298 @@
+// FrameSpec's names, the capabilities table and validate() (include/lacuna/frame_spec.h).
+#include "lacuna/frame_spec.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lacuna {
+
+std::string to_string(Renderer r) {
+    switch (r) {
+        case Renderer::RayMarcher: return "march";
+        case Renderer::Slicer: return "slice";
+        case Renderer::Segments: return "segments";
+    }
+    return "?";
+}
+
+// ---- Structures ---------------------------------------------------------------------------------
+namespace {
+
+// Name and AccelKind of each alternative; the order is the variant's.
+template <class T> struct Traits;
+template <> struct Traits<structure::None> { static constexpr const char* name = "none"; static constexpr std::optional<AccelKind> kind = AccelKind::None; };
+template <> struct Traits<structure::MinMax> { static constexpr const char* name = "minmax"; static constexpr std::optional<AccelKind> kind = AccelKind::MinMax; };
+template <> struct Traits<structure::MinMaxInterval> { static constexpr const char* name = "minmax-interval"; static constexpr std::optional<AccelKind> kind = AccelKind::MinMaxInterval; };
+template <> struct Traits<structure::Bitfield> { static constexpr const char* name = "bitfield"; static constexpr std::optional<AccelKind> kind = AccelKind::Bitfield; };
+template <> struct Traits<structure::Boolean> { static constexpr const char* name = "boolean"; static constexpr std::optional<AccelKind> kind = AccelKind::Boolean; };
+template <> struct Traits<structure::Distance> { static constexpr const char* name = "distance"; static constexpr std::optional<AccelKind> kind = AccelKind::Distance; };
+template <> struct Traits<structure::Chebyshev> { static constexpr const char* name = "chebyshev"; static constexpr std::optional<AccelKind> kind = AccelKind::Chebyshev; };
+template <> struct Traits<structure::KdTree> { static constexpr const char* name = "kdtree"; static constexpr std::optional<AccelKind> kind = AccelKind::KdTree; };
+template <> struct Traits<structure::Grid> { static constexpr const char* name = "grid"; static constexpr std::optional<AccelKind> kind = AccelKind::Grid; };
+template <> struct Traits<structure::GrowingBoxes> { static constexpr const char* name = "boxes"; static constexpr std::optional<AccelKind> kind = std::nullopt; };
+template <> struct Traits<structure::LabelOctree> { static constexpr const char* name = "label-octree"; static constexpr std::optional<AccelKind> kind = std::nullopt; };
+
+template <class T>
+constexpr bool kHasOctree = requires(T t) { t.octree; };
+
+}  // namespace
+
+std::string structure_name(const Structure& s) {
+    return std::visit([](const auto& v) { return std::string(Traits<std::decay_t<decltype(v)>>::name); }, s);
+}
+
+std::optional<AccelKind> accel_kind(const Structure& s) {
+    return std::visit([](const auto& v) { return Traits<std::decay_t<decltype(v)>>::kind; }, s);
+}
+
+Structure structure_of(AccelKind k, const AccelOptions& o) {
+    const structure::Octree oct{o.leaf_cells, o.initial_level, o.bidirectional};
+    switch (k) {
+        case AccelKind::None: return structure::None{};
+        case AccelKind::MinMax: return structure::MinMax{oct};
+        case AccelKind::MinMaxInterval: return structure::MinMaxInterval{oct};
+        case AccelKind::Bitfield: return structure::Bitfield{oct, o.bitfield_bits};
+        case AccelKind::Boolean: return structure::Boolean{oct};
+        case AccelKind::Distance: return structure::Distance{o.distance_block};
+        case AccelKind::Chebyshev: return structure::Chebyshev{o.distance_block};
+        case AccelKind::KdTree:
+            return structure::KdTree{o.kd_max_boxes, o.kd_delta, o.kd_min_volume, o.kd_min_gain,
+                                     o.kd_max_depth};
+        case AccelKind::Grid: return structure::Grid{};
+    }
+    return structure::None{};
+}
+
+std::optional<AccelOptions> accel_options(const Structure& s, Interpolation interpolation,
+                                          int threads) {
+    AccelOptions o;
+    o.interpolation = interpolation;
+    o.threads = threads;
+    bool ray = true;
+    std::visit(
+        [&](const auto& v) {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (kHasOctree<T>) {
+                o.leaf_cells = v.octree.leaf_cells;
+                o.initial_level = v.octree.initial_level;
+                o.bidirectional = v.octree.bidirectional;
+            }
+            if constexpr (std::is_same_v<T, structure::Bitfield>) o.bitfield_bits = v.bits;
+            if constexpr (std::is_same_v<T, structure::Distance> ||
+                          std::is_same_v<T, structure::Chebyshev>)
+                o.distance_block = v.block;
+            if constexpr (std::is_same_v<T, structure::KdTree>) {
+                o.kd_max_boxes = v.max_boxes;
+                o.kd_delta = v.delta;
+                o.kd_min_volume = v.min_volume;
+                o.kd_min_gain = v.min_gain;
+                o.kd_max_depth = v.max_depth;
+            }
+            ray = Traits<T>::kind.has_value();
+        },
+        s);
+    if (!ray) return std::nullopt;
+    return o;
+}
+
+std::vector<Structure> all_structures() {
+    std::vector<Structure> out;
+    [&]<size_t... I>(std::index_sequence<I...>) {
+        (out.push_back(std::variant_alternative_t<I, Structure>{}), ...);
+    }(std::make_index_sequence<std::variant_size_v<Structure>>{});
+    return out;
+}
+
+// ---- Capabilities -------------------------------------------------------------------------------
+std::string to_string(Feature f) {
+    switch (f) {
+        case Feature::Shading: return "shading";
+        case Feature::GradientOpacity: return "gradient_opacity";
+        case Feature::Shadows: return "shadows";
+        case Feature::ClipPlanes: return "clip_planes";
+        case Feature::Crop: return "crop";
+        case Feature::Blend: return "blend";
+        case Feature::Jitter: return "jitter";
+        case Feature::TwoTfs: return "two_tfs";
+        case Feature::Nearest: return "nearest";
+        case Feature::EarlyTermination: return "early_termination";
+        case Feature::SampleCounts: return "sample_counts";
+        case Feature::Occlusion: return "occlusion";
+    }
+    return "?";
+}
+
+std::vector<Feature> all_features() {
+    return {Feature::Shading, Feature::GradientOpacity, Feature::Shadows,  Feature::ClipPlanes,
+            Feature::Crop,    Feature::Blend,           Feature::Jitter,   Feature::TwoTfs,
+            Feature::Nearest, Feature::EarlyTermination, Feature::SampleCounts, Feature::Occlusion};
+}
+
+bool RendererCapabilities::takes(const Structure& s) const {
+    const std::string n = structure_name(s);
+    return std::find(structures.begin(), structures.end(), n) != structures.end();
+}
+
+bool RendererCapabilities::has(Feature f) const {
+    return std::find(features.begin(), features.end(), f) != features.end();
+}
+
+// The table. Why each row is what it is:
+//   ray marcher  every ray-marching structure (the cursor interface, src/accel/cursor.h) and every
+//                feature of the feature kernel; not the slicer's boxes or the label octree.
+//   slicer       box sources only: the whole volume (none), the kd-tree's subvolume list and the
+//                growing boxes' BSP order (src/slice/box_sources.h); it composites TF colour and
+//                opacity on planes, so no gradient features, clipping or other blend modes.
+//   segments     the label octree, or (mask mode) any intensity structure through set_accel:
+//                exact, since the mask only lowers opacities. No features of the feature kernel.
+const std::vector<RendererCapabilities>& capabilities() {
+    static const std::vector<RendererCapabilities> table = [] {
+        std::vector<std::string> ray;
+        for (const Structure& s : all_structures())
+            if (accel_kind(s)) ray.push_back(structure_name(s));
+        std::vector<std::string> intensity;
+        for (const std::string& n : ray)
+            if (n != "none") intensity.push_back(n);
+        std::vector<std::string> segments = {"none", "label-octree"};
+        segments.insert(segments.end(), intensity.begin(), intensity.end());
+        return std::vector<RendererCapabilities>{
+            {Renderer::RayMarcher,
+             ray,
+             {Feature::Shading, Feature::GradientOpacity, Feature::Shadows, Feature::ClipPlanes,
+              Feature::Crop, Feature::Blend, Feature::Jitter, Feature::TwoTfs, Feature::Nearest,
+              Feature::EarlyTermination, Feature::SampleCounts},
+             {}},
+            {Renderer::Slicer,
+             {"none", "kdtree", "boxes"},
+             {Feature::Nearest, Feature::EarlyTermination, Feature::Occlusion},
+             {}},
+            {Renderer::Segments,
+             segments,
+             {Feature::Nearest, Feature::EarlyTermination, Feature::SampleCounts},
+             intensity},
+        };
+    }();
+    return table;
+}
+
+const RendererCapabilities& capabilities(Renderer r) { return capabilities()[size_t(r)]; }
+
+// ---- Validation ---------------------------------------------------------------------------------
+FrameError::FrameError(std::string field, std::string expected)
+    : Error("frame", field, expected), m_field(std::move(field)), m_expected(std::move(expected)) {}
+
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& expected) {
+    throw FrameError(field, expected);
+}
+
+bool finite(float v) { return std::isfinite(v); }
+
+// The features a spec uses, each with the field that switches it on.
+std::vector<std::pair<Feature, const char*>> used_features(const FrameSpec& s) {
+    std::vector<std::pair<Feature, const char*>> out;
+    const FeatureOptions& f = s.features;
+    if (f.shading != ShadingModel::None) out.push_back({Feature::Shading, "features.shading"});
+    if (f.gradient_opacity.enabled)
+        out.push_back({Feature::GradientOpacity, "features.gradient_opacity"});
+    if (f.shadows.enabled) out.push_back({Feature::Shadows, "features.shadows"});
+    if (!f.clip_planes.empty()) out.push_back({Feature::ClipPlanes, "features.clip_planes"});
+    if (f.crop) out.push_back({Feature::Crop, "features.crop"});
+    if (f.blend != BlendMode::Composite) out.push_back({Feature::Blend, "features.blend"});
+    if (f.jitter) out.push_back({Feature::Jitter, "features.jitter"});
+    if (s.two_tfs) out.push_back({Feature::TwoTfs, "two_tfs"});
+    if (s.sampling.interpolation == Interpolation::Nearest)
+        out.push_back({Feature::Nearest, "sampling.interpolation"});
+    if (s.sampling.early_termination)
+        out.push_back({Feature::EarlyTermination, "sampling.early_termination"});
+    if (s.count_samples) out.push_back({Feature::SampleCounts, "count_samples"});
+    if (s.slicer.occlusion) out.push_back({Feature::Occlusion, "slicer.occlusion"});
+    return out;
+}
+
+void validate_structure(const Structure& st) {
+    std::visit(
+        [](const auto& v) {
+            using T = std::decay_t<decltype(v)>;
+            auto leaf = [](int l, const char* field) {
+                if (l < 2 || l > 64 || (l & (l - 1)) != 0)
+                    fail(field, "expected a power of two in 2..64, got " + std::to_string(l));
+            };
+            auto bits = [](int b, const char* field) {
+                if (b != 8 && b != 16 && b != 32 && b != 64 && b != 128)
+                    fail(field, "expected 8, 16, 32, 64 or 128, got " + std::to_string(b));
+            };
+            if constexpr (kHasOctree<T>) leaf(v.octree.leaf_cells, "structure.octree.leaf_cells");
+            if constexpr (std::is_same_v<T, structure::Bitfield>) bits(v.bits, "structure.bits");
+            if constexpr (std::is_same_v<T, structure::LabelOctree>) {
+                leaf(v.leaf_cells, "structure.leaf_cells");
+                bits(v.bits, "structure.bits");
+            }
+            if constexpr (std::is_same_v<T, structure::Distance> ||
+                          std::is_same_v<T, structure::Chebyshev>)
+                if (v.block < 1 || v.block > 64) fail("structure.block", "expected 1..64 cells");
+        },
+        st);
+}
+
+}  // namespace
+
+void validate(const FrameSpec& s) {
+    // 1. The image and the camera.
+    if (s.width < 1 || s.width > 16384) fail("width", "expected 1..16384 pixels");
+    if (s.height < 1 || s.height > 16384) fail("height", "expected 1..16384 pixels");
+    const OrbitParams& o = s.camera.orbit;
+    if (!(o.zoom > 0.f && o.zoom <= 1000.f)) fail("camera.orbit.zoom", "expected 0 < zoom <= 1000");
+    if (!(o.fov_y_deg > 0.f && o.fov_y_deg < 180.f))
+        fail("camera.orbit.fov_y_deg", "expected 0 < degrees < 180");
+    if (!finite(o.azimuth_deg) || !finite(o.elevation_deg))
+        fail("camera.orbit", "expected finite azimuth and elevation degrees");
+    if (!finite(s.camera.pan_x) || !finite(s.camera.pan_y)) fail("camera.pan", "expected finite numbers");
+    for (float c : {s.background.x, s.background.y, s.background.z})
+        if (!(c >= 0.f && c <= 1.f)) fail("background", "expected R, G, B in [0, 1]");
+    // 2. Sampling.
+    if (!(s.sampling.step > 0.f && s.sampling.step <= 64.f))
+        fail("sampling.step", "expected 0 < step <= 64");
+    if (s.sampling.early_termination &&
+        !(*s.sampling.early_termination > 0.f && *s.sampling.early_termination < 1.f))
+        fail("sampling.early_termination", "expected an opacity in (0, 1), or none (off)");
+    // 3. The structure: taken by the renderer, its parameters in range.
+    const RendererCapabilities& cap = capabilities(s.renderer);
+    if (!cap.takes(s.structure)) {
+        std::string names;
+        for (const std::string& n : cap.structures) names += (names.empty() ? "" : ", ") + n;
+        fail("structure", "the " + to_string(s.renderer) + " renderer takes " + names + ", not '" +
+                              structure_name(s.structure) + "'");
+    }
+    if (s.renderer == Renderer::Segments && s.segments.mode == SegmentMode::Labels) {
+        const auto& m = cap.masked_only_structures;
+        if (std::find(m.begin(), m.end(), structure_name(s.structure)) != m.end())
+            fail("structure", "the label volume alone takes none or label-octree, not '" +
+                                  structure_name(s.structure) + "'");
+    }
+    validate_structure(s.structure);
+    // 4. Features: each one the renderer has, in range.
+    for (const auto& [feature, field] : used_features(s))
+        if (!cap.has(feature))
+            fail(field, "the " + to_string(s.renderer) + " renderer has no " + to_string(feature));
+    if (s.two_tfs && s.features.clip_planes.empty())
+        fail("two_tfs", "expected a clip plane to split the two TFs at");
+    try {
+        validate_features(s.features);
+    } catch (const Error& e) {
+        // validate_features (src/render/feature_render.cpp) still names the CLI's flags.
+        fail("features", e.what());
+    }
+    // 5. The slicer's and the segments' own options.
+    if (s.renderer == Renderer::Slicer) {
+        if (!(s.slicer.occlusion_threshold > 0.f && s.slicer.occlusion_threshold <= 1.f))
+            fail("slicer.occlusion_threshold", "expected 0 < T <= 1");
+        if (s.slicer.occlusion_map < 1 || s.slicer.occlusion_map > 4096)
+            fail("slicer.occlusion_map", "expected 1..4096 cells");
+    }
+    if (s.renderer == Renderer::Segments && !(s.segments.tint >= 0.f && s.segments.tint <= 1.f))
+        fail("segments.tint", "expected a number in [0,1]");
+}
+
+}  // namespace lacuna

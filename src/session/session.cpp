@@ -1,0 +1,377 @@
+// Session (include/lacuna/session.h): the lazily built structures, their TF versions, and the one
+// translation of a FrameSpec into each renderer's options.
+#include "lacuna/session.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "lacuna/error.h"
+#include "lacuna/orientation.h"
+#include "slice/box_sources.h"
+#include "slice/slice_renderer.h"
+
+namespace lacuna {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// What the renderers take for "early termination off": an opacity compositing never reaches
+// (accumulated opacity stays <= 1). The one place FrameSpec's nullopt becomes a number.
+constexpr float kNoTermination = 2.f;
+
+float ert_of(const Sampling& s) { return s.early_termination.value_or(kNoTermination); }
+
+// Something built for some TF: it holds version `version` of the session's TF, as the front LUT
+// alone or (two_tfs) as the union of front and back.
+struct TfHeld {
+    uint64_t version = 0;  // 0: no TF yet (the session's versions start at 1)
+    bool with_back = false;
+    bool current(uint64_t v, bool back) const { return version == v && with_back == back; }
+};
+
+}  // namespace
+
+struct Session::State {
+    std::unique_ptr<RayMarcher> marcher;
+    std::unique_ptr<SliceRenderer> slicer;
+    // What the marcher and the slicer hold (the marcher's back LUT separately: setting it
+    // invalidates the marcher's cached gradient and light volumes).
+    uint64_t marcher_version = 0, slicer_version = 0;
+    bool marcher_back = false;
+    uint64_t marcher_back_version = 0;
+
+    struct BuiltAccel {
+        Structure structure;
+        Interpolation interpolation;
+        std::unique_ptr<Accel> accel;
+        TfHeld held;
+    };
+    struct BuiltSource {
+        Structure structure;
+        std::unique_ptr<BoxSource> source;
+        TfHeld held;
+    };
+    struct BuiltSegments {
+        SegmentOptions options;
+        bool own_labels = false;  // built over the session's label volume (else the volume)
+        std::unique_ptr<SegmentRenderer> renderer;
+        TfHeld held;
+    };
+    std::vector<BuiltAccel> accels;
+    std::vector<BuiltSource> sources;
+    std::vector<BuiltSegments> segments;
+    SegmentRenderer* current_segments = nullptr;  // the one prepare() set up for the frame
+};
+
+Session::Session(Volume volume, int threads)
+    : m_volume(std::make_unique<Volume>(std::move(volume))),
+      m_threads(threads),
+      m_state(std::make_unique<State>()) {}
+
+Session::~Session() = default;
+
+Box3f Session::bounds() const { return world_bounds(*m_volume); }
+
+bool Session::set_transfer_function(const TransferFunction& tf) {
+    if (m_has_tf && tf == m_tf) return false;
+    m_tf = tf;
+    m_has_tf = true;
+    m_lut = discretise(m_tf, m_volume->vis_range());
+    ++m_tf_version;
+    return true;
+}
+
+void Session::set_back_transfer_function(const std::optional<TransferFunction>& tf) {
+    if (tf)
+        m_back_lut = discretise(*tf, m_volume->vis_range());
+    else
+        m_back_lut.reset();
+    ++m_tf_version;
+}
+
+void Session::set_labels(Volume labels) {
+    check_label_volume(labels, m_volume.get(), "labels");
+    m_labels = std::make_unique<Volume>(std::move(labels));
+    m_label_table.reset();
+    m_state->segments.clear();
+    m_state->current_segments = nullptr;
+}
+
+const LabelTable& Session::label_table() const {
+    if (!m_label_table) m_label_table = default_label_table(label_volume());
+    return *m_label_table;
+}
+
+Camera Session::camera(const FrameSpec& spec) const {
+    // The segment renderer frames its label map (the same grid; its geometry may differ).
+    const Box3f b = world_bounds(spec.renderer == Renderer::Segments && m_labels ? *m_labels : *m_volume);
+    OrbitParams op = spec.camera.orbit;
+    if (spec.camera.pan_x != 0.f || spec.camera.pan_y != 0.f) {
+        // Pan moves the orbit's target along the view plane (the camera's right and up, as
+        // Camera::orbit derives them), in units of the bounding sphere's radius.
+        const Camera base = Camera::orbit(b, op, spec.width, spec.height);
+        const Vec3f f = base.forward();
+        Vec3f world_up{0, 0, 1};
+        if (std::abs(dot(world_up, f)) > 0.999f) world_up = {0, 1, 0};
+        const Vec3f right = normalize(cross(f, world_up));
+        const Vec3f up = cross(right, f);
+        const float radius = 0.5f * length(b.extent());
+        op.has_target = true;
+        op.target = b.center() + right * (spec.camera.pan_x * radius) + up * (spec.camera.pan_y * radius);
+    }
+    return Camera::orbit(b, op, spec.width, spec.height);
+}
+
+void Session::check_tfs(const FrameSpec& spec) const {
+    const bool labels_alone =
+        spec.renderer == Renderer::Segments && spec.segments.mode == SegmentMode::Labels;
+    if (!m_has_tf && !labels_alone)
+        throw Error("session", "transfer function", "none was set (Session::set_transfer_function)");
+    if (spec.two_tfs && !m_back_lut)
+        throw Error("session", "back transfer function",
+                    "two_tfs needs one (Session::set_back_transfer_function)");
+    if (spec.renderer == Renderer::Segments && spec.segments.mode == SegmentMode::Masked && !m_labels)
+        throw Error("session", "labels", "mask mode needs a label volume (Session::set_labels)");
+}
+
+namespace {
+
+// Brings `target` to the session's TF: the front LUT, or with two TFs their union (the structure
+// then skips only where both are transparent). Returns the seconds it took (0: it held it).
+template <class T>
+double sync_tf(T& target, TfHeld& held, uint64_t version, bool with_back, const TransferLut& lut,
+               const std::optional<TransferLut>& back) {
+    if (held.current(version, with_back)) return 0;
+    const auto t0 = Clock::now();
+    target.set_transfer_function(with_back ? union_lut(lut, *back) : lut);
+    held = {version, with_back};
+    return seconds_since(t0);
+}
+
+}  // namespace
+
+FrameResult Session::prepare(const FrameSpec& spec) {
+    validate(spec);
+    check_tfs(spec);
+    FrameResult out;
+    State& s = *m_state;
+    const bool back = spec.two_tfs;
+
+    // The intensity structure of the ray marcher, or of the segment renderer's mask mode.
+    auto accel_for = [&](const Structure& st) -> Accel& {
+        for (auto& b : s.accels)
+            if (b.structure == st && b.interpolation == spec.sampling.interpolation) {
+                out.tf_sync_seconds += sync_tf(*b.accel, b.held, m_tf_version, back, m_lut, m_back_lut);
+                return *b.accel;
+            }
+        const auto t0 = Clock::now();
+        auto accel = make_accel(*accel_kind(st), *m_volume,
+                                *accel_options(st, spec.sampling.interpolation, m_threads));
+        out.build_seconds += seconds_since(t0);
+        s.accels.push_back({st, spec.sampling.interpolation, std::move(accel), {}});
+        auto& b = s.accels.back();
+        out.tf_sync_seconds += sync_tf(*b.accel, b.held, m_tf_version, back, m_lut, m_back_lut);
+        return *b.accel;
+    };
+
+    switch (spec.renderer) {
+        case Renderer::RayMarcher: {
+            if (!s.marcher) s.marcher = std::make_unique<RayMarcher>(*m_volume);
+            if (s.marcher_version != m_tf_version) {
+                const auto t0 = Clock::now();
+                s.marcher->set_transfer_function(m_lut);
+                s.marcher_version = m_tf_version;
+                out.tf_sync_seconds += seconds_since(t0);
+            }
+            // The back LUT only when it changes: setting it drops the marcher's cached gradient
+            // and light volumes.
+            if (back != s.marcher_back || (back && s.marcher_back_version != m_tf_version)) {
+                const auto t0 = Clock::now();
+                s.marcher->set_back_transfer_function(back ? *m_back_lut : TransferLut{});
+                s.marcher_back = back;
+                s.marcher_back_version = m_tf_version;
+                out.tf_sync_seconds += seconds_since(t0);
+            }
+            Accel& a = accel_for(spec.structure);
+            s.marcher->set_accel(&a);
+            out.structure = a.stats();
+            break;
+        }
+        case Renderer::Slicer: {
+            if (!s.slicer) s.slicer = std::make_unique<SliceRenderer>(*m_volume);
+            if (s.slicer_version != m_tf_version) {
+                const auto t0 = Clock::now();
+                s.slicer->set_transfer_function(m_lut);
+                s.slicer_version = m_tf_version;
+                out.tf_sync_seconds += seconds_since(t0);
+            }
+            // None: the whole volume as one box (no source; the 'Basic' slicer).
+            const BoxSource* source = nullptr;
+            if (!std::holds_alternative<structure::None>(spec.structure)) {
+                State::BuiltSource* found = nullptr;
+                for (auto& b : s.sources)
+                    if (b.structure == spec.structure) found = &b;
+                if (!found) {
+                    const auto tb = Clock::now();
+                    AccelOptions ao;
+                    ao.threads = m_threads;
+                    BoxesOptions bo;
+                    std::string name = "kdtree";
+                    if (const auto* kd = std::get_if<structure::KdTree>(&spec.structure)) {
+                        ao = *accel_options(*kd, Interpolation::Trilinear, m_threads);
+                    } else if (const auto* gb = std::get_if<structure::GrowingBoxes>(&spec.structure)) {
+                        name = "boxes";
+                        bo.coalesce = gb->coalesce;
+                        bo.coalesce_edge = gb->coalesce_edge;
+                    }
+                    s.sources.push_back({spec.structure, make_box_source(name, *m_volume, ao, bo), {}});
+                    out.build_seconds += seconds_since(tb);
+                    found = &s.sources.back();
+                }
+                out.tf_sync_seconds += sync_tf(*found->source, found->held, m_tf_version, false, m_lut, m_back_lut);
+                source = found->source.get();
+            }
+            s.slicer->set_box_source(source);
+            break;
+        }
+        case Renderer::Segments: {
+            const bool masked = spec.segments.mode == SegmentMode::Masked;
+            const auto* lo = std::get_if<structure::LabelOctree>(&spec.structure);
+            SegmentOptions so;
+            so.mode = spec.segments.mode;
+            so.tint = spec.segments.tint;
+            so.skip = lo != nullptr;
+            if (lo) {
+                so.leaf_cells = lo->leaf_cells;
+                so.bitfield_bits = lo->bits;
+            }
+            const bool own = m_labels != nullptr;
+            State::BuiltSegments* found = nullptr;
+            for (auto& b : s.segments)
+                if (b.own_labels == own && b.options.mode == so.mode && b.options.skip == so.skip &&
+                    b.options.leaf_cells == so.leaf_cells && b.options.bitfield_bits == so.bitfield_bits &&
+                    b.options.tint == so.tint)
+                    found = &b;
+            if (!found) {
+                const auto tb = Clock::now();
+                const Volume& labels = own ? *m_labels : *m_volume;
+                s.segments.push_back({so, own,
+                                      std::make_unique<SegmentRenderer>(masked ? m_volume.get() : nullptr,
+                                                                        labels, so),
+                                      {}});
+                out.build_seconds += seconds_since(tb);
+                found = &s.segments.back();
+            }
+            SegmentRenderer& seg = *found->renderer;
+            s.current_segments = &seg;
+            if (masked) {
+                out.tf_sync_seconds += sync_tf(seg, found->held, m_tf_version, false, m_lut, m_back_lut);
+                // Without the label octree, any intensity structure skips (exact: the mask only
+                // lowers opacities); None marches every sample.
+                const Accel* a = nullptr;
+                if (!lo && !std::holds_alternative<structure::None>(spec.structure)) {
+                    Accel& acc = accel_for(spec.structure);
+                    out.structure = acc.stats();
+                    a = &acc;
+                }
+                if (!lo) seg.set_accel(a);
+            }
+            out.segments = seg.stats();
+            break;
+        }
+    }
+    return out;
+}
+
+FrameResult Session::render(const FrameSpec& spec) {
+    FrameResult out = prepare(spec);
+    State& s = *m_state;
+    const Camera cam = camera(spec);
+    RenderOptions ro;
+    ro.step = spec.sampling.step;
+    ro.interpolation = spec.sampling.interpolation;
+    ro.ert = ert_of(spec.sampling);
+    ro.threads = m_threads;
+    ro.background = spec.background;
+    ro.count_samples = spec.count_samples;
+    ro.features = spec.features;
+    switch (spec.renderer) {
+        case Renderer::RayMarcher: {
+            RenderResult r = s.marcher->render(cam, ro);
+            out.image = std::move(r.image);
+            out.sample_counts = std::move(r.sample_counts);
+            out.stats = r.stats;
+            break;
+        }
+        case Renderer::Slicer: {
+            SliceOptions o;
+            o.step = spec.sampling.step;
+            o.ert = ert_of(spec.sampling);
+            o.threads = m_threads;
+            o.background = spec.background;
+            o.nearest = spec.sampling.interpolation == Interpolation::Nearest;
+            if (spec.slicer.occlusion) {
+                o.occlusion.mode = OcclusionMode::CullClip;
+                o.occlusion.threshold = spec.slicer.occlusion_threshold;
+                o.occlusion.map_size = spec.slicer.occlusion_map;
+            }
+            SliceResult r = s.slicer->render(cam, o);
+            out.image = std::move(r.image);
+            const SliceStats& st = r.stats;
+            out.stats.seconds = st.seconds;
+            out.stats.cpu_seconds = st.cpu_seconds;
+            out.stats.samples = st.samples;
+            out.stats.pixels = uint64_t(spec.width) * uint64_t(spec.height);
+            out.stats.rays = out.stats.pixels;  // the slicer has no rays: samples per pixel
+            SlicerFrameStats fs;
+            fs.boxes = st.boxes;
+            fs.polygons = st.polygons;
+            fs.setup_fraction = st.setup_fraction();
+            fs.setup_cpu_fraction = st.setup_cpu_fraction();
+            fs.map_updates = st.map_updates;
+            fs.desired_updates = st.desired_updates;
+            fs.boxes_culled = st.boxes_culled;
+            fs.boxes_clipped = st.boxes_clipped;
+            fs.skipped_fraction = st.skipped_fraction();
+            fs.culled_fraction = st.culled_fraction();
+            fs.clipped_fraction = st.clipped_fraction();
+            fs.occlusion_seconds = st.occlusion_seconds;
+            out.slicer = fs;
+            break;
+        }
+        case Renderer::Segments: {
+            SegmentRenderer* seg = s.current_segments;
+            seg->set_labels(spec.segments.labels ? *spec.segments.labels : label_table());
+            RenderResult r = seg->render(cam, ro);
+            out.image = std::move(r.image);
+            out.sample_counts = std::move(r.sample_counts);
+            out.stats = r.stats;
+            out.segments = seg->stats();
+            break;
+        }
+    }
+    return out;
+}
+
+void Session::refine() {
+    for (auto& b : m_state->accels) b.accel->refine();
+}
+
+void Session::drop_structures() {
+    m_state->accels.clear();
+    m_state->sources.clear();
+    m_state->segments.clear();
+    m_state->current_segments = nullptr;
+    if (m_state->marcher) m_state->marcher->set_accel(nullptr);
+    if (m_state->slicer) m_state->slicer->set_box_source(nullptr);
+}
+
+size_t Session::built_count() const {
+    return m_state->accels.size() + m_state->sources.size() + m_state->segments.size();
+}
+
+}  // namespace lacuna
