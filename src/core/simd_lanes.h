@@ -713,6 +713,49 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
     return _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
 }
 
+// Leaping, sixteen lanes: leap8's operations on positions already clamped into [0, hi].
+LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& g, __m512 x, __m512 y,
+                                                           __m512 z, __mmask16 valid, __m512 inv_dt,
+                                                           const LeapInverse& li, __mmask16& taken,
+                                                           __m512i& adv) {
+    const __m512 zero = _mm512_setzero_ps();
+    const __m512i ione = _mm512_set1_epi32(1);
+    const __m512 q[3] = {x, y, z};
+    __m512i c[3];
+    for (int a = 0; a < 3; ++a)
+        c[a] = _mm512_min_epi32(_mm512_cvttps_epi32(q[a]), _mm512_set1_epi32(g.cell[a]));
+    const __m512i idx = _mm512_add_epi32(
+        _mm512_add_epi32(_mm512_mullo_epi32(_mm512_srli_epi32(c[2], 2), _mm512_set1_epi32(g.leap_sz)),
+                         _mm512_mullo_epi32(_mm512_srli_epi32(c[1], 2), _mm512_set1_epi32(g.leap_sy))),
+        _mm512_srli_epi32(c[0], 2));
+    const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 1);
+    const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
+    const __mmask16 skip = _mm512_mask_test_epi32_mask(valid, d, d);
+    taken = valid & ~skip;
+    // The exit of the box of bricks within d - 1: min_a (face_a - q_a) / dir_a.
+    const __m512i d4 = _mm512_slli_epi32(d, 2), back = _mm512_sub_epi32(_mm512_set1_epi32(4), d4);
+    const __m512i lo = _mm512_set1_epi32(~3);
+    __m512 exit_t = _mm512_set1_ps(16777216.f);
+    for (int a = 0; a < 3; ++a) {
+        const __m512 inv = _mm512_load_ps(li.inv[a]);
+        const __m512i ahead = _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), d4, back);
+        const __m512 face = _mm512_cvtepi32_ps(_mm512_add_epi32(_mm512_and_si512(c[a], lo), ahead));
+        exit_t = _mm512_min_ps(exit_t, _mm512_mul_ps(_mm512_sub_ps(face, q[a]), inv));
+    }
+    // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
+    const __m512i leap = _mm512_add_epi32(
+        _mm512_cvttps_epi32(_mm512_min_ps(_mm512_mul_ps(exit_t, inv_dt), _mm512_set1_ps(16777216.f))), ione);
+    adv = _mm512_mask_blend_epi32(skip, ione, leap);
+}
+// leap_inverse8's clamped 1 / dir, sixteen lanes.
+LACUNA_AVX512 inline __attribute__((always_inline)) void leap_inverse16(__m512 dx, __m512 dy, __m512 dz,
+                                                                   LeapInverse& li) {
+    const __m512 big = _mm512_set1_ps(1e30f), nbig = _mm512_set1_ps(-1e30f), one = _mm512_set1_ps(1.f);
+    const __m512 d[3] = {dx, dy, dz};
+    for (int a = 0; a < 3; ++a)
+        _mm512_store_ps(li.inv[a], _mm512_max_ps(nbig, _mm512_min_ps(big, _mm512_div_ps(one, d[a]))));
+}
+
 template <bool kNearest, class T, class Refill, bool kLeap = false>
 LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
                                 Refill& refill) {
@@ -738,13 +781,7 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     n = _mm512_load_si512(s.n);                                                             \
     ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b);           \
     aa = _mm512_load_ps(s.a);                                                               \
-    if constexpr (kLeap) {                                                                  \
-        const __m512 big = _mm512_set1_ps(1e30f), nbig = _mm512_set1_ps(-1e30f);           \
-        const __m512 d3[3] = {dx, dy, dz};                                                  \
-        for (int a = 0; a < 3; ++a)                                                         \
-            _mm512_store_ps(linv.inv[a], _mm512_max_ps(nbig, _mm512_min_ps(big,             \
-                                         _mm512_div_ps(one, d3[a]))));                      \
-    }
+    if constexpr (kLeap) leap_inverse16(dx, dy, dz, linv);
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m512 inv_dt = _mm512_set1_ps(1.f / g.dt);
     int waiting = 0;
@@ -783,37 +820,7 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead.
         __mmask16 taken = valid;
         __m512i adv = ione;
-        if constexpr (kLeap) {
-            const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), _mm512_set1_epi32(g.cell[0]));
-            const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), _mm512_set1_epi32(g.cell[1]));
-            const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(z), _mm512_set1_epi32(g.cell[2]));
-            const __m512i fi = _mm512_srli_epi32(ci, 2), fj = _mm512_srli_epi32(cj, 2),
-                          fk = _mm512_srli_epi32(ck, 2);
-            const __m512i idx = _mm512_add_epi32(
-                _mm512_add_epi32(_mm512_mullo_epi32(fk, _mm512_set1_epi32(g.leap_sz)),
-                                 _mm512_mullo_epi32(fj, _mm512_set1_epi32(g.leap_sy))),
-                fi);
-            const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 1);
-            const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
-            const __mmask16 skip = _mm512_mask_test_epi32_mask(valid, d, d);
-            taken = valid & ~skip;
-            // The exit of the box of bricks within d - 1 (see "Leaping"): min_a (face_a - q_a) / dir_a.
-            const __m512i d4 = _mm512_slli_epi32(d, 2), back = _mm512_sub_epi32(_mm512_set1_epi32(4), d4);
-            const __m512i lo = _mm512_set1_epi32(~3);
-            const __m512i c3[3] = {ci, cj, ck};
-            const __m512 q3[3] = {x, y, z};
-            __m512 exit_t = _mm512_set1_ps(16777216.f);
-            for (int a = 0; a < 3; ++a) {
-                const __m512 inv = _mm512_load_ps(linv.inv[a]);
-                const __m512i ahead = _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), d4, back);
-                const __m512 face = _mm512_cvtepi32_ps(_mm512_add_epi32(_mm512_and_si512(c3[a], lo), ahead));
-                exit_t = _mm512_min_ps(exit_t, _mm512_mul_ps(_mm512_sub_ps(face, q3[a]), inv));
-            }
-            // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
-            const __m512i leap = _mm512_add_epi32(
-                _mm512_cvttps_epi32(_mm512_min_ps(_mm512_mul_ps(exit_t, inv_dt), _mm512_set1_ps(16777216.f))), ione);
-            adv = _mm512_mask_blend_epi32(skip, ione, leap);
-        }
+        if constexpr (kLeap) leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
         u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
         const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));

@@ -577,10 +577,13 @@ struct ShadeRecords {
     alignas(32) int32_t h_ok[kShadeRecords];
     alignas(32) int32_t pending[kShadeRecords];
 };
-// The visible samples waiting for shading, in the order they were composited.
+// The visible samples waiting for shading, in the order they were composited. At most 7 wait
+// when a lane set pushes (the kernels shade every full eight at once), so 32 hold 7 + 16 plus a
+// batch's padding.
+inline constexpr int kShadeQueue = 32;
 struct ShadeQueue {
-    alignas(32) float x[16], y[16], z[16], w[16], a[16];
-    alignas(32) int32_t e[16], rec[16];
+    alignas(64) float x[kShadeQueue], y[kShadeQueue], z[kShadeQueue], w[kShadeQueue], a[kShadeQueue];
+    alignas(64) int32_t e[kShadeQueue], rec[kShadeQueue];
     int n = 0;
 };
 // What shading needs besides the samples: the grid, the straight-colour LUT (RGBA floats), the
@@ -599,41 +602,61 @@ LACUNA_AVX2 inline Dir8 gather_dir8(const float (*d)[kShadeRecords], __m256i rec
             _mm256_i32gather_ps(d[2], rec, 4)};
 }
 
-// Shades the first min(q.n, 8) queued samples into their records and drops them from the queue.
+// Shades the n <= 8 queued samples from i0 on into their records (lanes past n are padding,
+// computed and never used).
 template <class T>
-LACUNA_AVX2 void shade_queue8(const ShadeFrame& f, const T* data, ShadeQueue& q, ShadeRecords& R) {
-    const int n = std::min(q.n, 8);
-    if (n == 0) return;
-    for (int j = n; j < 8; ++j)  // padding (computed, never used)
-        q.x[j] = q.x[n - 1], q.y[j] = q.y[n - 1], q.z[j] = q.z[n - 1], q.rec[j] = q.rec[n - 1];
+LACUNA_AVX2 void shade_run8(const ShadeFrame& f, const T* data, ShadeQueue& q, int i0, int n,
+                            ShadeRecords& R) {
+    float *qx = q.x + i0, *qy = q.y + i0, *qz = q.z + i0;
+    int32_t* qrec = q.rec + i0;
+    for (int j = n; j < 8; ++j)
+        qx[j] = qx[n - 1], qy[j] = qy[n - 1], qz[j] = qz[n - 1], qrec[j] = qrec[n - 1];
     alignas(32) float gx[8], gy[8], gz[8];
     if (f.grad)
-        volume_gradients8(f.g, f.grad, q.x, q.y, q.z, gx, gy, gz);
+        volume_gradients8(f.g, f.grad, qx, qy, qz, gx, gy, gz);
     else
-        gradients8(f.g, data, q.x, q.y, q.z, gx, gy, gz);
+        gradients8(f.g, data, qx, qy, qz, gx, gy, gz);
     alignas(32) float r[8], g[8], b[8];
     for (int j = 0; j < 8; ++j) {
-        const float* c = f.raw + 4 * ptrdiff_t(q.e[std::min(j, n - 1)]);
+        const float* c = f.raw + 4 * ptrdiff_t(q.e[i0 + std::min(j, n - 1)]);
         r[j] = c[0], g[j] = c[1], b[j] = c[2];
     }
-    const __m256i rec = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.rec));
+    const __m256i rec = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(qrec));
     const __m256 h_ok = _mm256_castsi256_ps(
         _mm256_i32gather_epi32(reinterpret_cast<const int*>(R.h_ok), rec, 4));
     phong8(f.phong, f.li, gather_dir8(R.l, rec), gather_dir8(R.v, rec), gather_dir8(R.h, rec), h_ok,
            gx, gy, gz, r, g, b, n);
     for (int j = 0; j < n; ++j) {
-        const int i = q.rec[j];
-        const float w = q.w[j], a = q.a[j];
+        const int i = qrec[j];
+        const float w = q.w[i0 + j], a = q.a[i0 + j];
         R.r[i] += w * r[j] * a;
         R.g[i] += w * g[j] * a;
         R.b[i] += w * b[j] * a;
         --R.pending[i];
     }
-    q.n -= n;
+}
+// Drops the first m queued samples (shaded) from the queue.
+inline void queue_drop(ShadeQueue& q, int m) {
+    q.n -= m;
     for (int j = 0; j < q.n; ++j) {
-        q.x[j] = q.x[n + j], q.y[j] = q.y[n + j], q.z[j] = q.z[n + j];
-        q.w[j] = q.w[n + j], q.a[j] = q.a[n + j], q.e[j] = q.e[n + j], q.rec[j] = q.rec[n + j];
+        q.x[j] = q.x[m + j], q.y[j] = q.y[m + j], q.z[j] = q.z[m + j];
+        q.w[j] = q.w[m + j], q.a[j] = q.a[m + j], q.e[j] = q.e[m + j], q.rec[j] = q.rec[m + j];
     }
+}
+// Shades the first min(q.n, 8) queued samples into their records and drops them from the queue.
+template <class T>
+LACUNA_AVX2 void shade_queue8(const ShadeFrame& f, const T* data, ShadeQueue& q, ShadeRecords& R) {
+    const int n = std::min(q.n, 8);
+    if (n == 0) return;
+    shade_run8(f, data, q, 0, n, R);
+    queue_drop(q, n);
+}
+// Shades every full eight of the queue, front to back; fewer than eight stay.
+template <class T>
+LACUNA_AVX2 void shade_full8(const ShadeFrame& f, const T* data, ShadeQueue& q, ShadeRecords& R) {
+    int i0 = 0;
+    for (; q.n - i0 >= 8; i0 += 8) shade_run8(f, data, q, i0, 8, R);
+    queue_drop(q, i0);
 }
 
 // march_lanes8's contract (refill, the lanes' state in `s`), with `lut` the step-corrected LUT
@@ -720,6 +743,102 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
     }
 #undef LACUNA_LOAD_LANES
 }
+
+
+// ---- Shading across rays (AVX-512): sixteen lanes ------------------------------------------------
+// march_shaded_lanes8 with march_lanes16's lane set (sixteen rays, trilinear16, leap16): per lane
+// the same operations, so the same bits. The visible samples of a lane set enter the queue by
+// compression in lane order (a ray's samples stay in its sample order: one per lane and
+// iteration), and every full eight is shaded by shade_run8.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+template <class T, class Refill>
+LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                                       const ShadeFrame& f, ShadeQueue& q, ShadeRecords& R,
+                                       const int32_t* rec, Refill& refill) {
+    const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
+    const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
+    const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
+                 vhi2 = _mm512_set1_ps(g.hi[2]);
+    const __m512 voff = _mm512_set1_ps(g.lut_offset), vscale = _mm512_set1_ps(g.lut_scale),
+                 vlast = _mm512_set1_ps(g.lut_last);
+    const __m512i vzero_entry = _mm512_set1_epi32(g.zero_entry), ione = _mm512_set1_epi32(1);
+    __m512 ox, oy, oz, dx, dy, dz, tb, aa;
+    __m512i kend, k, n, vrec;
+    __mmask16 active;
+#define LACUNA_LOAD_LANES                                                                   \
+    ox = _mm512_load_ps(s.ox), oy = _mm512_load_ps(s.oy), oz = _mm512_load_ps(s.oz);        \
+    dx = _mm512_load_ps(s.dx), dy = _mm512_load_ps(s.dy), dz = _mm512_load_ps(s.dz);        \
+    tb = _mm512_load_ps(s.t_base);                                                          \
+    kend = _mm512_load_si512(s.kend);                                                       \
+    active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active), _mm512_setzero_si512()); \
+    k = _mm512_load_si512(s.k);                                                             \
+    n = _mm512_load_si512(s.n);                                                             \
+    aa = _mm512_load_ps(s.a);                                                               \
+    vrec = _mm512_loadu_si512(rec); /* the lanes' records (a refill may change them) */     \
+    leap_inverse16(dx, dy, dz, linv);
+    LeapInverse linv;
+    const __m512 inv_dt = _mm512_set1_ps(1.f / g.dt);
+    int waiting = 0;
+    LACUNA_LOAD_LANES
+    int need;
+    for (;;) {
+        const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
+        const __m512 t =
+            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), vdt));
+        const __m512 px = _mm512_add_ps(ox, _mm512_mul_ps(t, dx));
+        const __m512 py = _mm512_add_ps(oy, _mm512_mul_ps(t, dy));
+        const __m512 pz = _mm512_add_ps(oz, _mm512_mul_ps(t, dz));
+        const __m512 x = _mm512_max_ps(zero, _mm512_min_ps(vhi0, px));
+        const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(vhi1, py));
+        const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(vhi2, pz));
+        const __m512 v = trilinear16(g, data, x, y, z, active);
+        __mmask16 taken;
+        __m512i adv;
+        leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
+        u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
+        const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
+        const __m512 ca = _mm512_i32gather_ps(_mm512_slli_epi32(entry, 2), lut + 3, 4);
+        const __m512 w = _mm512_sub_ps(one, aa);
+        aa = _mm512_add_ps(aa, _mm512_mul_ps(w, ca));
+        // The visible samples (a > 0; invalid lanes read the zero entry) join the queue, with
+        // the positions before clamping (march_shaded_lanes8's).
+        if (const __mmask16 vis = _mm512_cmp_ps_mask(ca, zero, _CMP_GT_OQ)) {
+            const int j = q.n;
+            _mm512_storeu_ps(q.x + j, _mm512_maskz_compress_ps(vis, px));
+            _mm512_storeu_ps(q.y + j, _mm512_maskz_compress_ps(vis, py));
+            _mm512_storeu_ps(q.z + j, _mm512_maskz_compress_ps(vis, pz));
+            _mm512_storeu_ps(q.w + j, _mm512_maskz_compress_ps(vis, w));
+            _mm512_storeu_ps(q.a + j, _mm512_maskz_compress_ps(vis, ca));
+            _mm512_storeu_si512(q.e + j, _mm512_maskz_compress_epi32(vis, entry));
+            _mm512_storeu_si512(q.rec + j, _mm512_maskz_compress_epi32(vis, vrec));
+            q.n = j + __builtin_popcount(unsigned(vis));
+            for (unsigned m = vis; m; m &= m - 1) ++R.pending[rec[__builtin_ctz(m)]];
+            if (q.n >= 8) shade_full8(f, data, q, R);
+        }
+        n = _mm512_mask_add_epi32(n, taken, n, ione);
+        k = _mm512_min_epi32(_mm512_mask_add_epi32(k, valid, k, adv), kend);
+        const __mmask16 over =
+            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, vert, _CMP_GE_OS);
+        kend = _mm512_mask_mov_epi32(kend, over, k);
+        need = int(over & active);
+        waiting |= need;
+        if (__builtin_popcount(unsigned(waiting)) >= 4 || waiting == int(active)) {
+            need = waiting;
+            waiting = 0;
+            _mm512_store_si512(s.kend, kend);
+            _mm512_store_si512(s.k, k);
+            _mm512_store_si512(s.n, n);
+            _mm512_store_ps(s.a, aa);
+            if (!refill(need)) return;
+            LACUNA_LOAD_LANES
+        }
+    }
+#undef LACUNA_LOAD_LANES
+}
+#pragma GCC diagnostic pop
 
 #endif  // LACUNA_SIMD_X86
 

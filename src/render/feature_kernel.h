@@ -846,7 +846,7 @@ private:
     const RenderOptions& m_opt;
     simd::ShadeRecords m_R{};
     simd::ShadeQueue m_q{};
-    alignas(32) int32_t m_rec[simd::kMaxLanes] = {};
+    alignas(64) int32_t m_rec[simd::kMaxLanes] = {};
     int m_free[simd::kShadeRecords], m_nfree = 0;
     int m_deferred[simd::kShadeRecords], m_ndeferred = 0;
     int m_x[simd::kShadeRecords] = {}, m_y[simd::kShadeRecords] = {};
@@ -866,8 +866,17 @@ void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Vol
     set_leap(lg, grid);
     ShadedLanesPolicy<T> policy(c, sf, data, out, opt);
     const float* lut = &corr_z[0].r;
-    // Every ray one run: the lanes leap (core/simd_lanes.h).
+    // Every ray one run: the lanes leap (core/simd_lanes.h); sixteen lanes on AVX-512 CPUs.
     static const NoAccel kWholeRay;
+    if (simd::active_isa() == simd::Isa::Avx512) {
+        schedule_tile_lanes<16>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
+                                counts.samples, counts.rays, [&](simd::Lanes& L, auto& refill) {
+                                    simd::march_shaded_lanes16<T, std::remove_reference_t<decltype(refill)>>(
+                                        L, lg, data, lut, sf, policy.queue(), policy.records(),
+                                        policy.lane_records(), refill);
+                                });
+        return;
+    }
     schedule_tile_lanes<8>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
                            counts.samples, counts.rays, [&](simd::Lanes& L, auto& refill) {
                                simd::march_shaded_lanes8<T, std::remove_reference_t<decltype(refill)>, true>(
