@@ -253,42 +253,62 @@
     }
     sel.value = names.includes(value) ? value : names[0];
   }
+  // What combines with what is the server's capabilities table (hello.capabilities, from
+  // lacuna::capabilities()): per renderer the accels it takes and its features; the segments
+  // toggle is a renderer of its own, drawn with caps.segments.renderer. The page only follows it.
+  const caps = () => hello.capabilities;
+  const current = () => (state.segments ? caps().segments : caps()[state.renderer]);
+  const setRenderer = (r) => { state.renderer = r; $('renderer').value = r; };
+  const noSegments = () => { state.segments = false; $('segments').checked = false; };
+  const noShading = () => { state.shading = false; $('shading').checked = false; };
+  const noClipping = () => {
+    state.clip = false; state.clipPlanes = []; $('clip-planes').value = ''; $('clip').checked = false;
+  };
+  // Switches off what the current renderer cannot take: an accel becomes its first one that skips
+  // (else its first), shading and clipping go off.
+  function fitToRenderer() {
+    const c = current();
+    if (!c.accels.includes(state.accel)) {
+      state.accel = c.accels.find((a) => a !== 'none') || c.accels[0];
+      $('accel').value = state.accel;
+    }
+    if (!c.features.includes('shading')) noShading();
+    if (!c.features.includes('clip_planes')) noClipping();
+  }
+  // A choice the current renderer cannot take moves to the first one that can (segments off).
+  function rendererFor(ok) {
+    if (ok(current())) return;
+    if (state.segments) noSegments();
+    if (ok(caps()[state.renderer])) return;
+    const r = hello.renderers.find((n) => ok(caps()[n]));
+    if (r) setRenderer(r);
+  }
   $('renderer').addEventListener('change', (e) => {
     state.renderer = e.target.value;
-    if (state.renderer === 'slice') {
-      // The slicer renders boxes: the whole volume (none) or the kd-tree's; no shading/clipping.
-      if (state.accel !== 'none' && state.accel !== 'kdtree') state.accel = 'kdtree';
-      $('accel').value = state.accel;
-      state.shading = state.clip = false; state.clipPlanes = []; $('clip-planes').value = '';
-      $('shading').checked = $('clip').checked = false;
-      state.segments = false;
-      $('segments').checked = false;
-    }
+    if (state.segments && caps().segments.renderer !== state.renderer) noSegments();
+    fitToRenderer();
     request(false);
   });
-  // Choices the slicer cannot render switch back to the ray marcher.
-  const marchIfSlicer = () => {
-    if (state.renderer === 'slice') { state.renderer = 'march'; $('renderer').value = 'march'; }
-  };
   $('accel').addEventListener('change', (e) => {
     state.accel = e.target.value;
-    if (state.accel !== 'none' && state.accel !== 'kdtree') marchIfSlicer();
+    rendererFor((c) => c.accels.includes(state.accel));
     request(false);
   });
   $('ert').addEventListener('change', (e) => { state.ert = e.target.checked; request(false); });
-  // Segments are drawn by the marcher without shading or clipping: the toggles exclude each other.
-  const noSegments = () => { state.segments = false; $('segments').checked = false; };
   $('segments').addEventListener('change', (e) => {
     state.segments = e.target.checked;
     if (state.segments) {
-      marchIfSlicer();
-      state.shading = state.clip = false; state.clipPlanes = []; $('clip-planes').value = '';
-      $('shading').checked = $('clip').checked = false;
+      setRenderer(caps().segments.renderer);
+      fitToRenderer();
     }
     request(false);
   });
   $('hide').addEventListener('change', (e) => { state.hide = e.target.value.trim(); request(false); });
-  $('shading').addEventListener('change', (e) => { state.shading = e.target.checked; if (state.shading) { marchIfSlicer(); noSegments(); } request(false); });
+  $('shading').addEventListener('change', (e) => {
+    state.shading = e.target.checked;
+    if (state.shading) rendererFor((c) => c.features.includes('shading'));
+    request(false);
+  });
   // Named anatomical views: the page sends the name ("camera": {"view": "left", ...}) and the
   // server takes the angles from the table `lacuna render --view` uses (lacuna/views.h), so a
   // view here is the CLI's view bit for bit. These angles only seed a drag away from the view.
@@ -306,10 +326,14 @@
                                    (p[0] !== 0 || p[1] !== 0 || p[2] !== 0));
     e.target.classList.toggle('invalid', !ok);
     state.clipPlanes = ok ? planes : [];
-    if (ok && planes.length) { marchIfSlicer(); noSegments(); }
+    if (ok && planes.length) rendererFor((c) => c.features.includes('clip_planes'));
     request(false);
   });
-  $('clip').addEventListener('change', (e) => { state.clip = e.target.checked; if (state.clip) { marchIfSlicer(); noSegments(); } request(false); });
+  $('clip').addEventListener('change', (e) => {
+    state.clip = e.target.checked;
+    if (state.clip) rendererFor((c) => c.features.includes('clip_planes'));
+    request(false);
+  });
   $('step').addEventListener('input', (e) => {
     state.step = Number(e.target.value);
     $('step-value').textContent = e.target.value;

@@ -62,14 +62,10 @@ void FrameRenderer::set_labels(Volume labels) {
 // `--clip` (the renderer moves them into the volume frame, docs/formats.md, World frame).
 FrameSpec FrameRenderer::frame_spec(const ViewRequest& req, int width, int height) const {
     FrameSpec f;
+    // Without a label volume the segments toggle does nothing (the page hides it).
     const bool segments = req.segments && m_session->has_labels();
-    f.renderer = req.renderer == RendererKind::Slice ? Renderer::Slicer
-                 : segments                          ? Renderer::Segments
-                                                     : Renderer::RayMarcher;
-    f.structure = f.renderer == Renderer::Segments && req.accel == AccelKind::Bitfield
-                      ? Structure{structure::LabelOctree{m_accel_options.leaf_cells,
-                                                         m_accel_options.bitfield_bits}}
-                      : structure_of(req.accel, m_accel_options);
+    f.renderer = frame_renderer(req.renderer, segments);
+    f.structure = frame_structure(req.accel, segments, m_accel_options);
     f.sampling.step = req.step;
     f.sampling.early_termination = req.ert ? std::optional<float>(0.99f) : std::nullopt;
     if (req.shading) f.features.shading = ShadingModel::Phong;

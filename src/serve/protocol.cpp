@@ -215,16 +215,25 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
             }
         }
     }
+    // What combines with what is the capabilities table's (lacuna/frame_spec.h), as the page
+    // receives it in the hello message.
     const bool clipped = r.clip || !r.clip_planes.empty();
-    if (r.segments && (r.shading || clipped || r.renderer == RendererKind::Slice))
-        reject("segments", "segments are drawn by the ray marcher without shading or clipping");
-    if (r.renderer == RendererKind::Slice) {
-        if (r.accel != AccelKind::None && r.accel != AccelKind::KdTree)
-            reject("accel", "the slice renderer takes none (Basic) or kdtree, not '" +
-                                to_string(r.accel) + "'");
-        if (r.shading || clipped)
-            reject("renderer", "the slice renderer has no shading or clipping");
+    if (r.segments && r.renderer != RendererKind::March)
+        reject("segments", "segments are drawn with the ray marcher's lattice ('renderer': 'march')");
+    const Renderer target = frame_renderer(r.renderer, r.segments);
+    const RendererCapabilities& cap = capabilities(target);
+    // The field blamed: the toggle that asked for a renderer without the feature.
+    const char* asked = r.segments ? "segments" : "renderer";
+    if (!cap.takes(frame_structure(r.accel, r.segments))) {
+        std::string names;
+        for (const std::string& n : accel_names())
+            if (cap.takes(frame_structure(parse_accel(n), r.segments)))
+                names += (names.empty() ? "" : ", ") + n;
+        reject("accel", "the " + to_string(target) + " renderer takes " + names + ", not '" +
+                            to_string(r.accel) + "'");
     }
+    if ((r.shading && !cap.has(Feature::Shading)) || (clipped && !cap.has(Feature::ClipPlanes)))
+        reject(asked, "the " + to_string(target) + " renderer has no shading or clipping");
     r.step = float(number(j, "step", 0.1, 8, ""));
 
     const json& tf = need(j, "tf", "");
@@ -239,6 +248,17 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     // lacuna::Error naming the field.
     r.tf = parse_transfer_function(tf.dump(), "tf");
     return r;
+}
+
+Renderer frame_renderer(RendererKind renderer, bool segments) {
+    if (renderer == RendererKind::Slice) return Renderer::Slicer;
+    return segments ? Renderer::Segments : Renderer::RayMarcher;
+}
+
+Structure frame_structure(AccelKind accel, bool segments, const AccelOptions& o) {
+    if (segments && accel == AccelKind::Bitfield)
+        return structure::LabelOctree{o.leaf_cells, o.bitfield_bits};
+    return structure_of(accel, o);
 }
 
 std::optional<uint64_t> request_id(std::string_view text, const Limits& limits) {
@@ -267,6 +287,20 @@ std::string hello_message(const HelloInfo& h) {
     j["tf"] = json::parse(to_json(h.initial_tf));
     j["accels"] = h.accels;
     j["renderers"] = h.renderers;
+    // The capabilities table in the page's words (see protocol.h).
+    json caps = json::object();
+    const std::pair<const char*, bool> rows[] = {{"march", false}, {"slice", false}, {"segments", true}};
+    for (const auto& [name, segments] : rows) {
+        const RendererKind kind = std::string(name) == "slice" ? RendererKind::Slice : RendererKind::March;
+        const RendererCapabilities& cap = capabilities(frame_renderer(kind, segments));
+        json accels = json::array(), features = json::array();
+        for (const std::string& a : h.accels)
+            if (cap.takes(frame_structure(parse_accel(a), segments))) accels.push_back(a);
+        for (Feature f : cap.features) features.push_back(to_string(f));
+        caps[name] = {{"accels", accels}, {"features", features}};
+        if (segments) caps[name]["renderer"] = "march";
+    }
+    j["capabilities"] = caps;
     j["labels"] = h.labels;
     j["limits"] = {{"max_message_bytes", h.limits.max_message_bytes},
                    {"max_side", h.limits.max_side},

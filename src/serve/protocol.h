@@ -17,7 +17,13 @@
 //   with an "error" message naming the field; the connection stays open.
 // Server -> page:
 //   text   {"type":"hello", ...}    once, on connect: volume, histogram, presets, accels,
-//                                    renderers, limits
+//                                    renderers, capabilities, limits
+//          "capabilities": {"march": {"accels": [...], "features": [...]}, "slice": {...},
+//                           "segments": {"renderer": "march", "accels": [...], "features": [...]}}
+//          is lacuna::capabilities() (lacuna/frame_spec.h) in the page's words: which of the
+//          "accels" each renderer (and the segments toggle, drawn with "renderer") takes, and its
+//          features by lacuna::to_string(Feature) ("shading", "clip_planes" for both "clip" and
+//          "clip_planes", ...). The page decides nothing else about what combines with what.
 //   text   {"type":"error", "id":N|null, "message":"..."}
 //   binary [u32 little-endian n][n bytes of JSON header {"type":"frame", ...}][JPEG bytes]
 #pragma once
@@ -28,6 +34,7 @@
 #include <vector>
 
 #include "lacuna/accel.h"
+#include "lacuna/frame_spec.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
@@ -75,6 +82,13 @@ struct ViewRequest {
     std::string hide;       // optional "hide": labels to hide, "1,2,37-42" (docs/segments.md)
     TransferFunction tf;
 };
+
+// The FrameSpec renderer and structure a request's "renderer", "segments" and "accel" name: the
+// segments toggle is the segment renderer (drawn on the ray marcher's lattice), whose "bitfield"
+// is the label bitfield octree; every other accel is the structure of that name, its parameters
+// from `o` (`lacuna serve --leaf/--bits`).
+Renderer frame_renderer(RendererKind renderer, bool segments);
+Structure frame_structure(AccelKind accel, bool segments, const AccelOptions& o = {});
 
 // Parses one message from the page. Throws lacuna::Error("message", field, expectation) for
 // anything malformed, oversized or out of range; never anything else.

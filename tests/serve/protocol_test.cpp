@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <string>
 
 #include "lacuna/error.h"
@@ -282,6 +283,65 @@ TEST(Protocol, RequestIdIsRecoveredForErrorsWhenPresent) {
     EXPECT_EQ(request_id(j.dump()), std::optional<uint64_t>(7));
     EXPECT_EQ(request_id("{"), std::nullopt);
     EXPECT_EQ(request_id("{\"id\":\"x\"}"), std::nullopt);
+}
+
+// The hello's capabilities are what parse_request accepts: for every renderer (and the segments
+// toggle) and every accel, a request is accepted exactly when the table lists the accel, and the
+// shading and clip toggles exactly when it lists the feature.
+TEST(Protocol, HelloCapabilitiesAreWhatRequestsMayCombine) {
+    SyntheticOptions so;
+    so.dims = {9, 8, 7};
+    Volume v = generate(SyntheticKind::Sphere, so);
+    HelloInfo h;
+    h.volume = &v;
+    h.initial_tf = preset("mr-brain");
+    h.accels = accel_names();
+    h.renderers = renderer_names();
+    const json caps = json::parse(hello_message(h))["capabilities"];
+    EXPECT_EQ(caps["slice"]["accels"], json::array({"none", "kdtree"}));
+    EXPECT_EQ(caps["march"]["accels"].size(), accel_names().size());
+    EXPECT_EQ(caps["segments"]["renderer"], "march");
+    auto has = [](const json& list, const std::string& x) {
+        return std::find(list.begin(), list.end(), json(x)) != list.end();
+    };
+    EXPECT_TRUE(has(caps["march"]["features"], "shading"));
+    EXPECT_FALSE(has(caps["slice"]["features"], "clip_planes"));
+    EXPECT_FALSE(has(caps["segments"]["features"], "shading"));
+    auto accepted = [](const json& j) {
+        try {
+            parse_request(j.dump());
+            return true;
+        } catch (const lacuna::Error&) {
+            return false;
+        }
+    };
+    for (const char* row : {"march", "slice", "segments"}) {
+        const json& c = caps[row];
+        json base = good_request();
+        base["renderer"] = std::string(row) == "segments" ? c["renderer"] : json(row);
+        if (std::string(row) == "segments") base["segments"] = true;
+        for (const std::string& accel : accel_names()) {
+            json j = base;
+            j["accel"] = accel;
+            EXPECT_EQ(accepted(j), has(c["accels"], accel)) << row << " " << accel;
+        }
+        base["accel"] = c["accels"][0];
+        ASSERT_TRUE(accepted(base)) << row;
+        json j = base;
+        j["shading"] = true;
+        EXPECT_EQ(accepted(j), has(c["features"], "shading")) << row;
+        for (const char* key : {"clip", "clip_planes"}) {
+            j = base;
+            j[key] = std::string(key) == "clip" ? json(true) : json::array({json::array({1, 0, 0, 0})});
+            EXPECT_EQ(accepted(j), has(c["features"], "clip_planes")) << row << " " << key;
+        }
+    }
+    // Segments are never drawn by the slicer.
+    json j = good_request();
+    j["renderer"] = "slice";
+    j["accel"] = "none";
+    j["segments"] = true;
+    expect_rejected(j, "segments");
 }
 
 TEST(Protocol, ServerMessagesAreWellFormed) {
