@@ -265,3 +265,46 @@ TEST(Session, PanZeroIsTheOrbitCameraAndPanMovesIt) {
 
 }  // namespace
 }  // namespace lacuna
+
+namespace lacuna {
+namespace {
+
+// The conformance property through the session, for every structure of the variant on every
+// renderer the capabilities table grants it: the image of the renderer without skipping, byte
+// for byte, after the structure was built for another TF (a TF change) and after refine().
+TEST(Session, EveryStructureGivesTheNoneImageOnEveryRendererThatTakesIt) {
+    for (const bool sparse : {true, false}) {
+        Session session(sparse ? block() : blobs(), 1);
+        session.set_labels(sparse ? block() : label_blobs());
+        session.set_transfer_function(window(0.55, 0.85));
+        for (const RendererCapabilities& cap : capabilities())
+            for (const Structure& st : all_structures()) {
+                if (!cap.takes(st)) continue;
+                FrameSpec f = spec(st);
+                f.renderer = cap.renderer;
+                session.render(f);  // built and synced for the first TF
+            }
+        session.set_transfer_function(window(0.15, 0.45));
+        for (const bool refined : {false, true}) {
+            if (refined) session.refine();
+            for (const RendererCapabilities& cap : capabilities()) {
+                FrameSpec none = spec(structure::None{});
+                none.renderer = cap.renderer;
+                const FrameResult reference = session.render(none);
+                for (const Structure& st : all_structures()) {
+                    if (!cap.takes(st)) continue;
+                    FrameSpec f = none;
+                    f.structure = st;
+                    const FrameResult r = session.render(f);
+                    EXPECT_TRUE(r.image.rgba == reference.image.rgba)
+                        << to_string(cap.renderer) << " " << structure_name(st) << " sparse " << sparse
+                        << " refined " << refined;
+                    EXPECT_LE(r.stats.samples, reference.stats.samples) << structure_name(st);
+                }
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lacuna
