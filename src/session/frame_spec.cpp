@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "session/structure_registry.h"
+
 namespace lacuna {
 
 std::string to_string(Renderer r) {
@@ -15,35 +17,12 @@ std::string to_string(Renderer r) {
     return "?";
 }
 
-// ---- Structures ---------------------------------------------------------------------------------
-namespace {
+// ---- Structures (the registry: src/session/structure_registry.h) -------------------------------
+using registry::kHasOctree;
 
-// Name and AccelKind of each alternative; the order is the variant's.
-template <class T> struct Traits;
-template <> struct Traits<structure::None> { static constexpr const char* name = "none"; static constexpr std::optional<AccelKind> kind = AccelKind::None; };
-template <> struct Traits<structure::MinMax> { static constexpr const char* name = "minmax"; static constexpr std::optional<AccelKind> kind = AccelKind::MinMax; };
-template <> struct Traits<structure::MinMaxInterval> { static constexpr const char* name = "minmax-interval"; static constexpr std::optional<AccelKind> kind = AccelKind::MinMaxInterval; };
-template <> struct Traits<structure::Bitfield> { static constexpr const char* name = "bitfield"; static constexpr std::optional<AccelKind> kind = AccelKind::Bitfield; };
-template <> struct Traits<structure::Boolean> { static constexpr const char* name = "boolean"; static constexpr std::optional<AccelKind> kind = AccelKind::Boolean; };
-template <> struct Traits<structure::Distance> { static constexpr const char* name = "distance"; static constexpr std::optional<AccelKind> kind = AccelKind::Distance; };
-template <> struct Traits<structure::Chebyshev> { static constexpr const char* name = "chebyshev"; static constexpr std::optional<AccelKind> kind = AccelKind::Chebyshev; };
-template <> struct Traits<structure::KdTree> { static constexpr const char* name = "kdtree"; static constexpr std::optional<AccelKind> kind = AccelKind::KdTree; };
-template <> struct Traits<structure::Grid> { static constexpr const char* name = "grid"; static constexpr std::optional<AccelKind> kind = AccelKind::Grid; };
-template <> struct Traits<structure::GrowingBoxes> { static constexpr const char* name = "boxes"; static constexpr std::optional<AccelKind> kind = std::nullopt; };
-template <> struct Traits<structure::LabelOctree> { static constexpr const char* name = "label-octree"; static constexpr std::optional<AccelKind> kind = std::nullopt; };
+std::string structure_name(const Structure& s) { return registry::entry(s).name; }
 
-template <class T>
-constexpr bool kHasOctree = requires(T t) { t.octree; };
-
-}  // namespace
-
-std::string structure_name(const Structure& s) {
-    return std::visit([](const auto& v) { return std::string(Traits<std::decay_t<decltype(v)>>::name); }, s);
-}
-
-std::optional<AccelKind> accel_kind(const Structure& s) {
-    return std::visit([](const auto& v) { return Traits<std::decay_t<decltype(v)>>::kind; }, s);
-}
+std::optional<AccelKind> accel_kind(const Structure& s) { return registry::entry(s).ray; }
 
 Structure structure_of(AccelKind k, const AccelOptions& o) {
     const structure::Octree oct{o.leaf_cells, o.initial_level, o.bidirectional};
@@ -68,7 +47,6 @@ std::optional<AccelOptions> accel_options(const Structure& s, Interpolation inte
     AccelOptions o;
     o.interpolation = interpolation;
     o.threads = threads;
-    bool ray = true;
     std::visit(
         [&](const auto& v) {
             using T = std::decay_t<decltype(v)>;
@@ -88,10 +66,9 @@ std::optional<AccelOptions> accel_options(const Structure& s, Interpolation inte
                 o.kd_min_gain = v.min_gain;
                 o.kd_max_depth = v.max_depth;
             }
-            ray = Traits<T>::kind.has_value();
         },
         s);
-    if (!ray) return std::nullopt;
+    if (!registry::entry(s).ray) return std::nullopt;
     return o;
 }
 
@@ -138,23 +115,21 @@ bool RendererCapabilities::has(Feature f) const {
 }
 
 // The table. Why each row is what it is:
-//   ray marcher  every ray-marching structure (the cursor interface, src/accel/cursor.h) and every
-//                feature of the feature kernel; not the slicer's boxes or the label octree.
-//   slicer       box sources only: the whole volume (none), the kd-tree's subvolume list and the
-//                growing boxes' BSP order (src/slice/box_sources.h); it composites TF colour and
-//                opacity on planes, so no gradient features, clipping or other blend modes.
-//   segments     the label octree, or (mask mode) any intensity structure through set_accel:
-//                exact, since the mask only lowers opacities. No features of the feature kernel.
+//   ray marcher  the structures with a ray face (the cursor interface, src/accel/cursor.h) and
+//                every feature of the feature kernel.
+//   slicer       the structures with a box face (src/slice/box_sources.h); it composites TF colour
+//                and opacity on planes, so no gradient features, clipping or other blend modes.
+//   segments     the label octree, or (mask mode) any ray structure through set_accel: exact,
+//                since the mask only lowers opacities. No features of the feature kernel.
 const std::vector<RendererCapabilities>& capabilities() {
     static const std::vector<RendererCapabilities> table = [] {
-        std::vector<std::string> ray;
-        for (const Structure& s : all_structures())
-            if (accel_kind(s)) ray.push_back(structure_name(s));
-        std::vector<std::string> intensity;
-        for (const std::string& n : ray)
-            if (n != "none") intensity.push_back(n);
-        std::vector<std::string> segments = {"none", "label-octree"};
-        segments.insert(segments.end(), intensity.begin(), intensity.end());
+        std::vector<std::string> ray, boxes, segments, intensity;
+        for (const registry::Entry& e : registry::kStructures) {
+            if (e.ray) ray.push_back(e.name);
+            if (e.boxes) boxes.push_back(e.name);
+            if (e.ray && *e.ray != AccelKind::None) intensity.push_back(e.name);
+            if (e.labels || e.ray) segments.push_back(e.name);
+        }
         return std::vector<RendererCapabilities>{
             {Renderer::RayMarcher,
              ray,
@@ -162,10 +137,7 @@ const std::vector<RendererCapabilities>& capabilities() {
               Feature::Crop, Feature::Blend, Feature::Jitter, Feature::TwoTfs, Feature::Nearest,
               Feature::EarlyTermination, Feature::SampleCounts},
              {}},
-            {Renderer::Slicer,
-             {"none", "kdtree", "boxes"},
-             {Feature::Nearest, Feature::EarlyTermination, Feature::Occlusion},
-             {}},
+            {Renderer::Slicer, boxes, {Feature::Nearest, Feature::EarlyTermination, Feature::Occlusion}, {}},
             {Renderer::Segments,
              segments,
              {Feature::Nearest, Feature::EarlyTermination, Feature::SampleCounts},

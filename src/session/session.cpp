@@ -7,6 +7,7 @@
 
 #include "lacuna/error.h"
 #include "lacuna/orientation.h"
+#include "session/structure_registry.h"
 #include "slice/box_sources.h"
 #include "slice/slice_renderer.h"
 
@@ -217,18 +218,21 @@ FrameResult Session::prepare(const FrameSpec& spec) {
                     if (b.structure == spec.structure) found = &b;
                 if (!found) {
                     const auto tb = Clock::now();
+                    // The box face by the registry's name (box_source_names()), with the
+                    // structure's parameters.
                     AccelOptions ao;
                     ao.threads = m_threads;
                     BoxesOptions bo;
-                    std::string name = "kdtree";
-                    if (const auto* kd = std::get_if<structure::KdTree>(&spec.structure)) {
-                        ao = *accel_options(*kd, Interpolation::Trilinear, m_threads);
-                    } else if (const auto* gb = std::get_if<structure::GrowingBoxes>(&spec.structure)) {
-                        name = "boxes";
+                    if (const auto ray = accel_options(spec.structure, Interpolation::Trilinear, m_threads))
+                        ao = *ray;
+                    if (const auto* gb = std::get_if<structure::GrowingBoxes>(&spec.structure)) {
                         bo.coalesce = gb->coalesce;
                         bo.coalesce_edge = gb->coalesce_edge;
                     }
-                    s.sources.push_back({spec.structure, make_box_source(name, *m_volume, ao, bo), {}});
+                    s.sources.push_back({spec.structure,
+                                         make_box_source(registry::entry(spec.structure).name,
+                                                         *m_volume, ao, bo),
+                                         {}});
                     out.build_seconds += seconds_since(tb);
                     found = &s.sources.back();
                 }

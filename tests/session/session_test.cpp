@@ -121,6 +121,14 @@ TEST(Session, TwoTfFramesAreTheHandWiredFrames) {
     EXPECT_TRUE(session.render(f).image.rgba == one.render(f).image.rgba);
 }
 
+// The registry's box faces are the box sources the slicer's factory knows.
+TEST(Session, TheSlicersStructuresAreTheBoxSources) {
+    std::vector<std::string> boxes;
+    for (const Structure& s : all_structures())
+        if (capabilities(Renderer::Slicer).takes(s)) boxes.push_back(structure_name(s));
+    EXPECT_EQ(boxes, box_source_names());
+}
+
 TEST(Session, SlicerFramesAreTheHandWiredFrames) {
     const Volume vol = blobs();
     const TransferLut lut = discretise(window(0.3, 0.7), vol.vis_range());
