@@ -586,6 +586,6 @@
   function round4(v) { return Math.round(v * 10000) / 10000; }
 
   // A small handle for scripts and tests (tests/e2e/viewer.e2e.mjs).
-  window.lacunaViewer = { state, opacityPointClient, frames: () => frames, frameLog };
+  window.lacunaViewer = { state, opacityPointClient, frames: () => frames, frameLog, hello: () => hello };
   connect();
 })();

@@ -114,9 +114,17 @@ try {
     const st = await page.evaluate(() => window.lacunaViewer.state);
     check(st.renderer === 'slice' && st.accel === 'kdtree' && !st.shading,
           `the slicer renders (structure ${st.accel})`);
+    // The page follows the server's capabilities table: a structure the slicer does not take
+    // moves the page to a renderer that does.
+    const caps = await page.evaluate(() => window.lacunaViewer.hello().capabilities);
+    check(caps && caps.slice.accels.join() === 'none,kdtree' && caps.march.accels.includes('bitfield'),
+          `the hello message carries the capabilities (slicer: ${caps && caps.slice.accels.join(', ')})`);
     const m = await page.evaluate(() => window.lacunaViewer.frames());
-    await page.selectOption('#renderer', 'march');
+    await page.selectOption('#accel', 'bitfield');
     await waitFullFrame(page, m);
+    const st2 = await page.evaluate(() => window.lacunaViewer.state);
+    check(st2.renderer === 'march' && st2.accel === 'bitfield',
+          `a structure the slicer lacks switches to the marcher (${st2.renderer}, ${st2.accel})`);
   }
 
   // A second tab at the same time.
