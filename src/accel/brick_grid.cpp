@@ -170,6 +170,60 @@ void BrickGrid::brick_range(int x, int y, int z, int& lo, int& hi) const {
     hi = m_hi[i];
 }
 
+// The leap map's high bytes (see leap_map): for every fine brick at distance 0, the sub-bricks
+// of 2^3 cells whose apron-inclusive cells hold a bit of the visible-cell mask. Per brick, the
+// mask's bits of the 6 x 6 x 6 cells 4b - 1 .. 4b + 4 (clipped to the grid; cells past it are
+// never sampled), one row of six along x at a time: row position p = 0..5 is cell 4b - 1 + p,
+// sub-brick half 0 covers p = 0..3, half 1 covers p = 2..5 (on every axis).
+// A brick whose apron range holds only visible entries (`all_visible(i)`) has every sub-brick
+// set without looking.
+template <class AllVisible>
+static void leap_sub_bricks(const Volume& v, const uint32_t* mask, const int nf[3], int threads,
+                            AllVisible&& all_visible, std::vector<uint16_t>& leap) {
+    const Vec3i d = v.dims();
+    const int cells[3] = {d.x - 1, d.y - 1, d.z - 1};
+    const size_t sy = size_t(d.x), sz = size_t(d.x) * size_t(d.y);
+    // Bits off .. off + n - 1 of the mask (n <= 6; the mask has two words of padding).
+    auto bits = [&](size_t off, int n) {
+        const size_t w = off >> 5;
+        const uint64_t x = uint64_t(mask[w]) | uint64_t(mask[w + 1]) << 32;
+        return unsigned(x >> (off & 31)) & ((1u << n) - 1u);
+    };
+    auto halves = [](int p) { return (p <= 3 ? 1 : 0) | (p >= 2 ? 2 : 0); };
+    parallel_for(size_t(nf[2]), threads, [&](size_t z0, size_t z1) {
+        for (int bz = int(z0); bz < int(z1); ++bz)
+            for (int by = 0; by < nf[1]; ++by)
+                for (int bx = 0; bx < nf[0]; ++bx) {
+                    const size_t i = (size_t(bz) * size_t(nf[1]) + size_t(by)) * size_t(nf[0]) + size_t(bx);
+                    uint16_t& e = leap[i];
+                    if (e != 0) continue;
+                    if (all_visible(i)) {
+                        e = 0xff00;
+                        continue;
+                    }
+                    const int x0 = std::max(4 * bx - 1, 0), x1 = std::min(4 * bx + 4, cells[0] - 1);
+                    unsigned sub = 0;
+                    for (int pk = 0; pk < 6; ++pk) {
+                        const int k = 4 * bz - 1 + pk;
+                        if (k < 0 || k >= cells[2]) continue;
+                        for (int pj = 0; pj < 6; ++pj) {
+                            const int j = 4 * by - 1 + pj;
+                            if (j < 0 || j >= cells[1]) continue;
+                            const unsigned row = bits(size_t(k) * sz + size_t(j) * sy + size_t(x0), x1 - x0 + 1)
+                                                 << (x0 - (4 * bx - 1));
+                            const unsigned m = (row & 0x0fu ? 1u : 0u) | (row & 0x3cu ? 2u : 0u);
+                            if (!m) continue;
+                            const int hy = halves(pj), hz = halves(pk);
+                            for (int qz = 0; qz < 2; ++qz)
+                                for (int qy = 0; qy < 2; ++qy)
+                                    if ((hz >> qz & 1) && (hy >> qy & 1)) sub |= m << (2 * qy + 4 * qz);
+                        }
+                    }
+                    e = uint16_t(sub << 8);
+                }
+    });
+}
+
 void BrickGrid::refine() {
     // Built for Nearest, a brick's occupancy also tests voxel bins, so an unoccupied brick may
     // hold cells whose range is visible: the mask (a trilinear notion) would be wrong there, and
@@ -195,8 +249,11 @@ void BrickGrid::refine() {
     const uint16_t* next = m_next_visible.data();
     const std::vector<int> f = chebyshev_distances(
         m_nf, [&](size_t i) { return next[m_fine_lo[i]] <= m_fine_hi[i]; });
-    m_leap.assign(f.size() + 3, 0);  // padding: kernels read 32-bit words
-    for (size_t i = 0; i < f.size(); ++i) m_leap[i] = uint8_t(f[i]);
+    m_leap.assign(f.size() + 1, 0);  // padding: kernels read 32-bit words
+    for (size_t i = 0; i < f.size(); ++i) m_leap[i] = uint16_t(f[i]);
+    const uint16_t* next_invisible = m_next_invisible.data();
+    leap_sub_bricks(m_volume, m_mask.data(), m_nf, m_opts.threads,
+                    [&](size_t i) { return next_invisible[m_fine_lo[i]] > m_fine_hi[i]; }, m_leap);
     m_stats.refine_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

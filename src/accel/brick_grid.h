@@ -55,16 +55,21 @@ public:
     // The mask once refine() has run for the current TF, else nullptr (the kernels then take
     // every sample of a run).
     const uint32_t* cell_mask() const { return m_mask_ready ? m_mask.data() : nullptr; }
-    // Also made by refine(): the leap map, per fine brick of 4^3 cells (kLeapLog2) with the
-    // one-cell apron of the bricks: 0 if its range may read a visible entry, else the Chebyshev
-    // distance (in fine bricks, capped at 255) to the nearest such brick. x fastest over
-    // leap_dims(), three bytes of padding (the lane kernels read 32-bit words); nullptr until
-    // refine() ran for the current TF. A ray at a point of fine brick b with distance d >= 1 may
-    // skip every sample within (d - 1) * 4 cells (L-infinity) of that point: those lie in fine
-    // bricks within distance d - 1 of b, all empty, and float error is absorbed by the apron
-    // (core/simd_lanes.h, "Leaping").
+    // Also made by refine(): the leap map, one 16-bit entry per fine brick of 4^3 cells
+    // (kLeapLog2), x fastest over leap_dims(), one entry of padding (the lane kernels read 32-bit
+    // words); nullptr until refine() ran for the current TF.
+    //   low byte d: 0 if the brick's range with the bricks' one-cell apron may read a visible
+    //     entry, else the Chebyshev distance (in fine bricks, capped at 255) to the nearest such
+    //     brick. A ray at a point of brick b with d >= 1 may skip every sample before it leaves
+    //     the box of bricks within distance d - 1 of b: all are empty, and float error is
+    //     absorbed by the apron (core/simd_lanes.h, "Leaping").
+    //   high byte, where d = 0: bit sx + 2 sy + 4 sz set iff the sub-brick of 2^3 cells at
+    //     (sx, sy, sz) in b, with its own one-cell apron (cells 4b + 2s - 1 .. 4b + 2s + 2 per
+    //     axis), holds a cell of the visible-cell mask (bits of sub-bricks past the grid, which
+    //     hold no sample's cell, are free). A ray in a clear sub-brick may skip every sample
+    //     before it leaves that sub-brick, by the same argument.
     static constexpr int kLeapLog2 = 2;
-    const uint8_t* leap_map() const { return m_mask_ready ? m_leap.data() : nullptr; }
+    const uint16_t* leap_map() const { return m_mask_ready ? m_leap.data() : nullptr; }
     const int* leap_dims() const { return m_nf; }
 
     int brick_log2() const { return m_log2; }
@@ -133,7 +138,7 @@ private:
     bool m_mask_ready = false;
     std::vector<uint16_t> m_fine_lo, m_fine_hi;  // apron ranges of the fine bricks (leap map)
     int m_nf[3] = {0, 0, 0};
-    std::vector<uint8_t> m_leap;
+    std::vector<uint16_t> m_leap;
 };
 
 // Front-to-back walk of one ray through the grid; hands out the stretches that may hold visible

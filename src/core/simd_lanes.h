@@ -27,7 +27,10 @@
 //     face_a = 4 b_a + (dir_a < 0 ? 4 - 4d : 4d),   T_a = (face_a - q_a) / dir_a,
 // and the lane skips s = floor(min_a T_a / dt) + 1 samples (T = min_a T_a >= 0, since
 // q_a lies in [4 b_a, 4 b_a + 4]): samples k .. k + s - 1 have (s - 1) dt <= T. The next sample
-// taken is the lattice's k + s.
+// taken is the lattice's k + s. At d = 0 the entry's high byte says which of the brick's eight
+// sub-bricks of 2^3 cells (with their own one-cell apron) may read a visible entry; in a clear
+// one the lane leaves that sub-brick the same way, with edge 2 and D = 1:
+//     face_a = (c_a & -2) + (dir_a < 0 ? 0 : 2).
 // Why this is exact. (1) Clamping only helps: where the clamped trajectory differs from the ray
 // it stays on the volume's boundary, which moves it no faster toward a face ahead than q + t dir
 // does. (2) Float error (T's rounding, the skipped samples' own positions, a few ulps of
@@ -90,9 +93,9 @@ struct LaneGrid {
     float lut_offset, lut_scale, lut_last;
     int32_t zero_entry;
     float ert;
-    // Leaping (kernels with kLeap): the grid's leap map (accel/brick_grid.h leap_map) and its
-    // strides in fine bricks.
-    const uint8_t* leap = nullptr;
+    // Leaping (kernels with kLeap): the grid's leap map (accel/brick_grid.h leap_map: per fine
+    // brick the distance d and, where d = 0, the sub-bricks' bits) and its strides in fine bricks.
+    const uint16_t* leap = nullptr;
     int32_t leap_sy = 0, leap_sz = 0;
 };
 
@@ -488,23 +491,34 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, 
                          _mm256_mullo_epi32(f[1], _mm256_set1_epi32(g.leap_sy))),
         f[0]);
     const __m256i w = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
-                                                  reinterpret_cast<const int*>(g.leap), idx, valid, 1);
+                                                  reinterpret_cast<const int*>(g.leap), idx, valid, 2);
     const __m256i d = _mm256_and_si256(w, _mm256_set1_epi32(0xff));
-    const __m256i skip = _mm256_andnot_si256(_mm256_cmpeq_epi32(d, _mm256_setzero_si256()), valid);
+    const __m256i one_i = _mm256_set1_epi32(1), zero_i = _mm256_setzero_si256();
+    // d = 0: the bit of c's sub-brick, (c_x & 2) / 2 + (c_y & 2) + (c_z & 2) * 2.
+    const __m256i two = _mm256_set1_epi32(2);
+    const __m256i sub = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_srli_epi32(_mm256_and_si256(c[0], two), 1), _mm256_and_si256(c[1], two)),
+        _mm256_slli_epi32(_mm256_and_si256(c[2], two), 1));
+    const __m256i sub_vis = _mm256_and_si256(
+        _mm256_srlv_epi32(_mm256_srli_epi32(_mm256_and_si256(w, _mm256_set1_epi32(0xff00)), 8), sub), one_i);
+    const __m256i coarse = _mm256_xor_si256(_mm256_cmpeq_epi32(d, zero_i), _mm256_set1_epi32(-1));
+    const __m256i skip = _mm256_and_si256(_mm256_or_si256(coarse, _mm256_cmpeq_epi32(sub_vis, zero_i)), valid);
     taken = _mm256_andnot_si256(skip, valid);
-    // The exit of the box of bricks within d - 1: min_a (face_a - q_a) / dir_a.
-    const __m256i d4 = _mm256_slli_epi32(d, 2), back = _mm256_sub_epi32(_mm256_set1_epi32(4), d4);
-    const __m256i lo = _mm256_set1_epi32(~3);
+    // The exit of the box: bricks within d - 1 (edge 4), or the sub-brick (edge 2, D = 1):
+    // face_a = (c_a & -edge) + (dir_a < 0 ? (1 - D) edge : D edge), min_a (face_a - q_a) / dir_a.
+    const __m256i D = _mm256_blendv_epi8(one_i, d, coarse);
+    const __m256i sh = _mm256_blendv_epi8(one_i, two, coarse);
+    const __m256i fwd = _mm256_sllv_epi32(D, sh), back = _mm256_sllv_epi32(_mm256_sub_epi32(one_i, D), sh);
+    const __m256i lo = _mm256_blendv_epi8(_mm256_set1_epi32(~1), _mm256_set1_epi32(~3), coarse);
     __m256 exit_t = _mm256_set1_ps(16777216.f);
     for (int a = 0; a < 3; ++a) {
         const __m256 inv = _mm256_load_ps(li.inv[a]);
         const __m256i ahead = _mm256_castps_si256(
-            _mm256_blendv_ps(_mm256_castsi256_ps(d4), _mm256_castsi256_ps(back), inv));
+            _mm256_blendv_ps(_mm256_castsi256_ps(fwd), _mm256_castsi256_ps(back), inv));
         const __m256 face = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_and_si256(c[a], lo), ahead));
         exit_t = _mm256_min_ps(exit_t, _mm256_mul_ps(_mm256_sub_ps(face, q[a]), inv));
     }
     // (capped at 2^24 samples, far past any ray's end: cvtt stays in range; T >= 0 up to -0)
-    const __m256i one_i = _mm256_set1_epi32(1);
     const __m256i leap = _mm256_add_epi32(
         _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(exit_t, inv_dt), _mm256_set1_ps(16777216.f))), one_i);
     adv = _mm256_blendv_epi8(one_i, leap, skip);
@@ -728,17 +742,26 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
         _mm512_add_epi32(_mm512_mullo_epi32(_mm512_srli_epi32(c[2], 2), _mm512_set1_epi32(g.leap_sz)),
                          _mm512_mullo_epi32(_mm512_srli_epi32(c[1], 2), _mm512_set1_epi32(g.leap_sy))),
         _mm512_srli_epi32(c[0], 2));
-    const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 1);
+    const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 2);
     const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
-    const __mmask16 skip = _mm512_mask_test_epi32_mask(valid, d, d);
+    const __m512i two = _mm512_set1_epi32(2);
+    const __m512i sub = _mm512_add_epi32(
+        _mm512_add_epi32(_mm512_srli_epi32(_mm512_and_si512(c[0], two), 1), _mm512_and_si512(c[1], two)),
+        _mm512_slli_epi32(_mm512_and_si512(c[2], two), 1));
+    const __m512i sub_bits = _mm512_srli_epi32(_mm512_and_si512(w, _mm512_set1_epi32(0xff00)), 8);
+    const __mmask16 coarse = _mm512_test_epi32_mask(d, d);
+    const __mmask16 sub_vis = _mm512_test_epi32_mask(_mm512_srlv_epi32(sub_bits, sub), ione);
+    const __mmask16 skip = valid & (coarse | ~sub_vis);
     taken = valid & ~skip;
-    // The exit of the box of bricks within d - 1: min_a (face_a - q_a) / dir_a.
-    const __m512i d4 = _mm512_slli_epi32(d, 2), back = _mm512_sub_epi32(_mm512_set1_epi32(4), d4);
-    const __m512i lo = _mm512_set1_epi32(~3);
+    // The exit of the box (leap8's form): bricks within d - 1, or the sub-brick.
+    const __m512i D = _mm512_mask_blend_epi32(coarse, ione, d);
+    const __m512i sh = _mm512_mask_blend_epi32(coarse, ione, two);
+    const __m512i fwd = _mm512_sllv_epi32(D, sh), back = _mm512_sllv_epi32(_mm512_sub_epi32(ione, D), sh);
+    const __m512i lo = _mm512_mask_blend_epi32(coarse, _mm512_set1_epi32(~1), _mm512_set1_epi32(~3));
     __m512 exit_t = _mm512_set1_ps(16777216.f);
     for (int a = 0; a < 3; ++a) {
         const __m512 inv = _mm512_load_ps(li.inv[a]);
-        const __m512i ahead = _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), d4, back);
+        const __m512i ahead = _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), fwd, back);
         const __m512 face = _mm512_cvtepi32_ps(_mm512_add_epi32(_mm512_and_si512(c[a], lo), ahead));
         exit_t = _mm512_min_ps(exit_t, _mm512_mul_ps(_mm512_sub_ps(face, q[a]), inv));
     }

@@ -136,6 +136,88 @@ TEST(BrickGrid, RefinedCellMaskIsTheVisibilityOfEveryCellsRange) {
     EXPECT_GT(invisible, 1000);
 }
 
+// The leap map against brute force from the built cell ranges: a fine brick (4^3 cells) is at
+// distance 0 iff some cell of it or of its one-cell apron has a visible range, else its
+// Chebyshev distance to the nearest such brick (capped at 255); a brick at distance 0 sets bit
+// sx + 2 sy + 4 sz iff some cell of sub-brick (sx, sy, sz) (2^3 cells) or of its apron does
+// (sub-bricks past the grid are free).
+TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
+    Rng rng{9109};
+    int near = 0, far = 0, sub_set = 0, sub_clear = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 40), rng);
+        AccelOptions o;
+        o.leaf_cells = 2 << rng.range(0, 3);
+        o.threads = rng.range(1, 3);
+        BrickGrid g(v, o);
+        const ValueToLut m(v.vis_range(), kDefaultLutSize);
+        TransferLut lut = random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng));
+        if (trial % 4 == 3)  // few visible entries: far bricks and clear sub-bricks
+            for (size_t e = 0; e < lut.entries.size(); ++e)
+                if (e % 37 != 5) lut.entries[e].a = 0.f;
+        if (trial % 8 == 6)  // all but one band visible: fully visible bricks
+            for (size_t e = 0; e < lut.entries.size(); ++e) lut.entries[e].a = e % 97 < 90 ? 0.5f : 0.f;
+        g.set_transfer_function(lut);
+        ASSERT_EQ(g.leap_map(), nullptr) << "no leap map before refine()";
+        g.refine();
+        const uint16_t* leap = g.leap_map();
+        ASSERT_NE(leap, nullptr);
+        const BuiltRanges cells = built_ranges(v, m, -4);
+        const int* n = cells.g.n;
+        // Is any cell of [lo, hi] (per axis, clipped) visible?
+        auto any_visible = [&](const int lo[3], const int hi[3]) {
+            for (int k = std::max(lo[2], 0); k <= std::min(hi[2], n[2] - 1); ++k)
+                for (int j = std::max(lo[1], 0); j <= std::min(hi[1], n[1] - 1); ++j)
+                    for (int i = std::max(lo[0], 0); i <= std::min(hi[0], n[0] - 1); ++i) {
+                        const size_t id = cells.g.index(i, j, k);
+                        if (scan_visible(lut, cells.lo[id], cells.hi[id])) return true;
+                    }
+            return false;
+        };
+        const int* nf = g.leap_dims();
+        for (int a = 0; a < 3; ++a) ASSERT_EQ(nf[a], (n[a] + 3) / 4);
+        std::vector<uint8_t> occ(size_t(nf[0]) * nf[1] * nf[2]);
+        for (int z = 0; z < nf[2]; ++z)
+            for (int y = 0; y < nf[1]; ++y)
+                for (int x = 0; x < nf[0]; ++x) {
+                    const int lo[3] = {4 * x - 1, 4 * y - 1, 4 * z - 1}, hi[3] = {4 * x + 4, 4 * y + 4, 4 * z + 4};
+                    occ[(size_t(z) * nf[1] + y) * nf[0] + x] = any_visible(lo, hi);
+                }
+        for (int z = 0; z < nf[2]; ++z)
+            for (int y = 0; y < nf[1]; ++y)
+                for (int x = 0; x < nf[0]; ++x) {
+                    int dist = 255;
+                    for (int c = 0; c < nf[2]; ++c)
+                        for (int b = 0; b < nf[1]; ++b)
+                            for (int a = 0; a < nf[0]; ++a)
+                                if (occ[(size_t(c) * nf[1] + b) * nf[0] + a])
+                                    dist = std::min(dist, std::max({std::abs(a - x), std::abs(b - y), std::abs(c - z)}));
+                    const uint16_t e = leap[(size_t(z) * nf[1] + y) * nf[0] + x];
+                    ASSERT_EQ(e & 0xff, dist) << describe(v, lut) << " fine brick " << x << "," << y << "," << z;
+                    if (dist > 0) {
+                        ASSERT_EQ(e >> 8, 0) << "sub-bricks of a far brick";
+                        ++far;
+                        continue;
+                    }
+                    ++near;
+                    for (int s = 0; s < 8; ++s) {
+                        const int o3[3] = {4 * x + 2 * (s & 1), 4 * y + 2 * (s >> 1 & 1), 4 * z + 2 * (s >> 2)};
+                        // (a sub-brick past the grid holds no sample's cell: its bit is free)
+                        if (o3[0] >= n[0] || o3[1] >= n[1] || o3[2] >= n[2]) continue;
+                        const int lo[3] = {o3[0] - 1, o3[1] - 1, o3[2] - 1}, hi[3] = {o3[0] + 2, o3[1] + 2, o3[2] + 2};
+                        const bool expect = any_visible(lo, hi);
+                        ASSERT_EQ(bool(e >> (8 + s) & 1), expect)
+                            << describe(v, lut) << " fine brick " << x << "," << y << "," << z << " sub-brick " << s;
+                        (expect ? sub_set : sub_clear)++;
+                    }
+                }
+    }
+    EXPECT_GT(near, 200);
+    EXPECT_GT(far, 200);
+    EXPECT_GT(sub_set, 500);
+    EXPECT_GT(sub_clear, 200);
+}
+
 // Zero everywhere but a few random voxels: empty blocks to leap over.
 Volume sparse_volume(VoxelType t, Vec3i dims, Rng& rng) {
     Volume v(dims, t);
