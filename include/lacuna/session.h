@@ -104,6 +104,11 @@ public:
 
 private:
     void check_tfs(const FrameSpec& spec) const;
+    // prepare()'s part for each renderer, and the intensity structure two of them share.
+    void prepare_marcher(const FrameSpec& spec, FrameResult& out);
+    void prepare_slicer(const FrameSpec& spec, FrameResult& out);
+    void prepare_segments(const FrameSpec& spec, FrameResult& out);
+    Accel& intensity_structure(const FrameSpec& spec, FrameResult& out);
 
     std::unique_ptr<Volume> m_volume;  // stable address: structures and renderers point at it
     std::unique_ptr<Volume> m_labels;

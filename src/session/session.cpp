@@ -155,209 +155,230 @@ double sync_tf(T& target, TfHeld& held, uint64_t version, bool with_back, const 
 
 }  // namespace
 
+// The intensity structure of the ray marcher, or of the segment renderer's mask mode: built the
+// first time, then brought to the session's TF (with two TFs, their union).
+Accel& Session::intensity_structure(const FrameSpec& spec, FrameResult& out) {
+    State& s = *m_state;
+    const Interpolation interp = spec.sampling.interpolation;
+    State::BuiltAccel* found = nullptr;
+    for (auto& b : s.accels)
+        if (b.structure == spec.structure && b.interpolation == interp) found = &b;
+    if (!found) {
+        const auto t0 = Clock::now();
+        auto accel = make_accel(*accel_kind(spec.structure), *m_volume,
+                                *accel_options(spec.structure, interp, m_threads));
+        out.build_seconds += seconds_since(t0);
+        s.accels.push_back({spec.structure, interp, std::move(accel), {}});
+        found = &s.accels.back();
+    }
+    out.tf_sync_seconds +=
+        sync_tf(*found->accel, found->held, m_tf_version, spec.two_tfs, m_lut, m_back_lut);
+    return *found->accel;
+}
+
+void Session::prepare_marcher(const FrameSpec& spec, FrameResult& out) {
+    State& s = *m_state;
+    const bool back = spec.two_tfs;
+    if (!s.marcher) s.marcher = std::make_unique<RayMarcher>(*m_volume);
+    if (s.marcher_version != m_tf_version) {
+        const auto t0 = Clock::now();
+        s.marcher->set_transfer_function(m_lut);
+        s.marcher_version = m_tf_version;
+        out.tf_sync_seconds += seconds_since(t0);
+    }
+    // The back LUT only when it changes: setting it drops the marcher's cached gradient and
+    // light volumes.
+    if (back != s.marcher_back || (back && s.marcher_back_version != m_tf_version)) {
+        const auto t0 = Clock::now();
+        s.marcher->set_back_transfer_function(back ? *m_back_lut : TransferLut{});
+        s.marcher_back = back;
+        s.marcher_back_version = m_tf_version;
+        out.tf_sync_seconds += seconds_since(t0);
+    }
+    Accel& a = intensity_structure(spec, out);
+    s.marcher->set_accel(&a);
+    out.structure = a.stats();
+}
+
+void Session::prepare_slicer(const FrameSpec& spec, FrameResult& out) {
+    State& s = *m_state;
+    if (!s.slicer) s.slicer = std::make_unique<SliceRenderer>(*m_volume);
+    if (s.slicer_version != m_tf_version) {
+        const auto t0 = Clock::now();
+        s.slicer->set_transfer_function(m_lut);
+        s.slicer_version = m_tf_version;
+        out.tf_sync_seconds += seconds_since(t0);
+    }
+    // None: the whole volume as one box (no source; the 'Basic' slicer).
+    if (std::holds_alternative<structure::None>(spec.structure)) {
+        s.slicer->set_box_source(nullptr);
+        return;
+    }
+    State::BuiltSource* found = nullptr;
+    for (auto& b : s.sources)
+        if (b.structure == spec.structure) found = &b;
+    if (!found) {
+        // The box face by the registry's name (box_source_names()), with the structure's
+        // parameters.
+        const auto t0 = Clock::now();
+        AccelOptions ao;
+        ao.threads = m_threads;
+        if (const auto ray = accel_options(spec.structure, Interpolation::Trilinear, m_threads))
+            ao = *ray;
+        BoxesOptions bo;
+        if (const auto* gb = std::get_if<structure::GrowingBoxes>(&spec.structure)) {
+            bo.coalesce = gb->coalesce;
+            bo.coalesce_edge = gb->coalesce_edge;
+        }
+        s.sources.push_back(
+            {spec.structure, make_box_source(registry::entry(spec.structure).name, *m_volume, ao, bo), {}});
+        out.build_seconds += seconds_since(t0);
+        found = &s.sources.back();
+    }
+    out.tf_sync_seconds += sync_tf(*found->source, found->held, m_tf_version, false, m_lut, m_back_lut);
+    s.slicer->set_box_source(found->source.get());
+}
+
+void Session::prepare_segments(const FrameSpec& spec, FrameResult& out) {
+    State& s = *m_state;
+    const bool masked = spec.segments.mode == SegmentMode::Masked;
+    const auto* octree = std::get_if<structure::LabelOctree>(&spec.structure);
+    SegmentOptions so;
+    so.mode = spec.segments.mode;
+    so.tint = spec.segments.tint;
+    so.skip = octree != nullptr;
+    if (octree) {
+        so.leaf_cells = octree->leaf_cells;
+        so.bitfield_bits = octree->bits;
+    }
+    // One segment renderer per options and label map (the label volume, else the volume).
+    const bool own = m_labels != nullptr;
+    State::BuiltSegments* found = nullptr;
+    for (auto& b : s.segments)
+        if (b.own_labels == own && b.options.mode == so.mode && b.options.skip == so.skip &&
+            b.options.leaf_cells == so.leaf_cells && b.options.bitfield_bits == so.bitfield_bits &&
+            b.options.tint == so.tint)
+            found = &b;
+    if (!found) {
+        const auto t0 = Clock::now();
+        auto seg = std::make_unique<SegmentRenderer>(masked ? m_volume.get() : nullptr,
+                                                     own ? *m_labels : *m_volume, so);
+        out.build_seconds += seconds_since(t0);
+        s.segments.push_back({so, own, std::move(seg), {}});
+        found = &s.segments.back();
+    }
+    SegmentRenderer& seg = *found->renderer;
+    s.current_segments = &seg;
+    if (masked) {
+        out.tf_sync_seconds += sync_tf(seg, found->held, m_tf_version, false, m_lut, m_back_lut);
+        // Without the label octree, any intensity structure skips (exact: the mask only lowers
+        // opacities); None marches every sample.
+        if (!octree) {
+            const Accel* a = nullptr;
+            if (!std::holds_alternative<structure::None>(spec.structure)) {
+                Accel& acc = intensity_structure(spec, out);
+                out.structure = acc.stats();
+                a = &acc;
+            }
+            seg.set_accel(a);
+        }
+    }
+    out.segments = seg.stats();
+}
+
 FrameResult Session::prepare(const FrameSpec& spec) {
     validate(spec);
     check_tfs(spec);
     FrameResult out;
-    State& s = *m_state;
-    const bool back = spec.two_tfs;
-
-    // The intensity structure of the ray marcher, or of the segment renderer's mask mode.
-    auto accel_for = [&](const Structure& st) -> Accel& {
-        for (auto& b : s.accels)
-            if (b.structure == st && b.interpolation == spec.sampling.interpolation) {
-                out.tf_sync_seconds += sync_tf(*b.accel, b.held, m_tf_version, back, m_lut, m_back_lut);
-                return *b.accel;
-            }
-        const auto t0 = Clock::now();
-        auto accel = make_accel(*accel_kind(st), *m_volume,
-                                *accel_options(st, spec.sampling.interpolation, m_threads));
-        out.build_seconds += seconds_since(t0);
-        s.accels.push_back({st, spec.sampling.interpolation, std::move(accel), {}});
-        auto& b = s.accels.back();
-        out.tf_sync_seconds += sync_tf(*b.accel, b.held, m_tf_version, back, m_lut, m_back_lut);
-        return *b.accel;
-    };
-
     switch (spec.renderer) {
-        case Renderer::RayMarcher: {
-            if (!s.marcher) s.marcher = std::make_unique<RayMarcher>(*m_volume);
-            if (s.marcher_version != m_tf_version) {
-                const auto t0 = Clock::now();
-                s.marcher->set_transfer_function(m_lut);
-                s.marcher_version = m_tf_version;
-                out.tf_sync_seconds += seconds_since(t0);
-            }
-            // The back LUT only when it changes: setting it drops the marcher's cached gradient
-            // and light volumes.
-            if (back != s.marcher_back || (back && s.marcher_back_version != m_tf_version)) {
-                const auto t0 = Clock::now();
-                s.marcher->set_back_transfer_function(back ? *m_back_lut : TransferLut{});
-                s.marcher_back = back;
-                s.marcher_back_version = m_tf_version;
-                out.tf_sync_seconds += seconds_since(t0);
-            }
-            Accel& a = accel_for(spec.structure);
-            s.marcher->set_accel(&a);
-            out.structure = a.stats();
-            break;
-        }
-        case Renderer::Slicer: {
-            if (!s.slicer) s.slicer = std::make_unique<SliceRenderer>(*m_volume);
-            if (s.slicer_version != m_tf_version) {
-                const auto t0 = Clock::now();
-                s.slicer->set_transfer_function(m_lut);
-                s.slicer_version = m_tf_version;
-                out.tf_sync_seconds += seconds_since(t0);
-            }
-            // None: the whole volume as one box (no source; the 'Basic' slicer).
-            const BoxSource* source = nullptr;
-            if (!std::holds_alternative<structure::None>(spec.structure)) {
-                State::BuiltSource* found = nullptr;
-                for (auto& b : s.sources)
-                    if (b.structure == spec.structure) found = &b;
-                if (!found) {
-                    const auto tb = Clock::now();
-                    // The box face by the registry's name (box_source_names()), with the
-                    // structure's parameters.
-                    AccelOptions ao;
-                    ao.threads = m_threads;
-                    BoxesOptions bo;
-                    if (const auto ray = accel_options(spec.structure, Interpolation::Trilinear, m_threads))
-                        ao = *ray;
-                    if (const auto* gb = std::get_if<structure::GrowingBoxes>(&spec.structure)) {
-                        bo.coalesce = gb->coalesce;
-                        bo.coalesce_edge = gb->coalesce_edge;
-                    }
-                    s.sources.push_back({spec.structure,
-                                         make_box_source(registry::entry(spec.structure).name,
-                                                         *m_volume, ao, bo),
-                                         {}});
-                    out.build_seconds += seconds_since(tb);
-                    found = &s.sources.back();
-                }
-                out.tf_sync_seconds += sync_tf(*found->source, found->held, m_tf_version, false, m_lut, m_back_lut);
-                source = found->source.get();
-            }
-            s.slicer->set_box_source(source);
-            break;
-        }
-        case Renderer::Segments: {
-            const bool masked = spec.segments.mode == SegmentMode::Masked;
-            const auto* lo = std::get_if<structure::LabelOctree>(&spec.structure);
-            SegmentOptions so;
-            so.mode = spec.segments.mode;
-            so.tint = spec.segments.tint;
-            so.skip = lo != nullptr;
-            if (lo) {
-                so.leaf_cells = lo->leaf_cells;
-                so.bitfield_bits = lo->bits;
-            }
-            const bool own = m_labels != nullptr;
-            State::BuiltSegments* found = nullptr;
-            for (auto& b : s.segments)
-                if (b.own_labels == own && b.options.mode == so.mode && b.options.skip == so.skip &&
-                    b.options.leaf_cells == so.leaf_cells && b.options.bitfield_bits == so.bitfield_bits &&
-                    b.options.tint == so.tint)
-                    found = &b;
-            if (!found) {
-                const auto tb = Clock::now();
-                const Volume& labels = own ? *m_labels : *m_volume;
-                s.segments.push_back({so, own,
-                                      std::make_unique<SegmentRenderer>(masked ? m_volume.get() : nullptr,
-                                                                        labels, so),
-                                      {}});
-                out.build_seconds += seconds_since(tb);
-                found = &s.segments.back();
-            }
-            SegmentRenderer& seg = *found->renderer;
-            s.current_segments = &seg;
-            if (masked) {
-                out.tf_sync_seconds += sync_tf(seg, found->held, m_tf_version, false, m_lut, m_back_lut);
-                // Without the label octree, any intensity structure skips (exact: the mask only
-                // lowers opacities); None marches every sample.
-                const Accel* a = nullptr;
-                if (!lo && !std::holds_alternative<structure::None>(spec.structure)) {
-                    Accel& acc = accel_for(spec.structure);
-                    out.structure = acc.stats();
-                    a = &acc;
-                }
-                if (!lo) seg.set_accel(a);
-            }
-            out.segments = seg.stats();
-            break;
-        }
+        case Renderer::RayMarcher: prepare_marcher(spec, out); break;
+        case Renderer::Slicer: prepare_slicer(spec, out); break;
+        case Renderer::Segments: prepare_segments(spec, out); break;
     }
     return out;
 }
+
+namespace {
+
+// The ray marcher's and the segment renderer's options for a spec.
+RenderOptions render_options(const FrameSpec& spec, int threads) {
+    RenderOptions ro;
+    ro.step = spec.sampling.step;
+    ro.interpolation = spec.sampling.interpolation;
+    ro.ert = ert_of(spec.sampling);
+    ro.threads = threads;
+    ro.background = spec.background;
+    ro.count_samples = spec.count_samples;
+    ro.features = spec.features;
+    return ro;
+}
+
+// The slicer's.
+SliceOptions slice_options(const FrameSpec& spec, int threads) {
+    SliceOptions o;
+    o.step = spec.sampling.step;
+    o.ert = ert_of(spec.sampling);
+    o.threads = threads;
+    o.background = spec.background;
+    o.nearest = spec.sampling.interpolation == Interpolation::Nearest;
+    if (spec.slicer.occlusion) {
+        o.occlusion.mode = OcclusionMode::CullClip;
+        o.occlusion.threshold = spec.slicer.occlusion_threshold;
+        o.occlusion.map_size = spec.slicer.occlusion_map;
+    }
+    return o;
+}
+
+SlicerFrameStats slicer_stats(const SliceStats& st) {
+    SlicerFrameStats fs;
+    fs.boxes = st.boxes;
+    fs.polygons = st.polygons;
+    fs.setup_fraction = st.setup_fraction();
+    fs.setup_cpu_fraction = st.setup_cpu_fraction();
+    fs.map_updates = st.map_updates;
+    fs.desired_updates = st.desired_updates;
+    fs.boxes_culled = st.boxes_culled;
+    fs.boxes_clipped = st.boxes_clipped;
+    fs.skipped_fraction = st.skipped_fraction();
+    fs.culled_fraction = st.culled_fraction();
+    fs.clipped_fraction = st.clipped_fraction();
+    fs.occlusion_seconds = st.occlusion_seconds;
+    return fs;
+}
+
+}  // namespace
 
 FrameResult Session::render(const FrameSpec& spec) {
     FrameResult out = prepare(spec);
     State& s = *m_state;
     const Camera cam = camera(spec);
-    RenderOptions ro;
-    ro.step = spec.sampling.step;
-    ro.interpolation = spec.sampling.interpolation;
-    ro.ert = ert_of(spec.sampling);
-    ro.threads = m_threads;
-    ro.background = spec.background;
-    ro.count_samples = spec.count_samples;
-    ro.features = spec.features;
+    RenderResult r;
     switch (spec.renderer) {
-        case Renderer::RayMarcher: {
-            RenderResult r = s.marcher->render(cam, ro);
-            out.image = std::move(r.image);
-            out.sample_counts = std::move(r.sample_counts);
-            out.stats = r.stats;
+        case Renderer::RayMarcher:
+            r = s.marcher->render(cam, render_options(spec, m_threads));
             break;
-        }
         case Renderer::Slicer: {
-            SliceOptions o;
-            o.step = spec.sampling.step;
-            o.ert = ert_of(spec.sampling);
-            o.threads = m_threads;
-            o.background = spec.background;
-            o.nearest = spec.sampling.interpolation == Interpolation::Nearest;
-            if (spec.slicer.occlusion) {
-                o.occlusion.mode = OcclusionMode::CullClip;
-                o.occlusion.threshold = spec.slicer.occlusion_threshold;
-                o.occlusion.map_size = spec.slicer.occlusion_map;
-            }
-            SliceResult r = s.slicer->render(cam, o);
-            out.image = std::move(r.image);
-            const SliceStats& st = r.stats;
-            out.stats.seconds = st.seconds;
-            out.stats.cpu_seconds = st.cpu_seconds;
-            out.stats.samples = st.samples;
-            out.stats.pixels = uint64_t(spec.width) * uint64_t(spec.height);
-            out.stats.rays = out.stats.pixels;  // the slicer has no rays: samples per pixel
-            SlicerFrameStats fs;
-            fs.boxes = st.boxes;
-            fs.polygons = st.polygons;
-            fs.setup_fraction = st.setup_fraction();
-            fs.setup_cpu_fraction = st.setup_cpu_fraction();
-            fs.map_updates = st.map_updates;
-            fs.desired_updates = st.desired_updates;
-            fs.boxes_culled = st.boxes_culled;
-            fs.boxes_clipped = st.boxes_clipped;
-            fs.skipped_fraction = st.skipped_fraction();
-            fs.culled_fraction = st.culled_fraction();
-            fs.clipped_fraction = st.clipped_fraction();
-            fs.occlusion_seconds = st.occlusion_seconds;
-            out.slicer = fs;
+            SliceResult sr = s.slicer->render(cam, slice_options(spec, m_threads));
+            r.image = std::move(sr.image);
+            r.stats.seconds = sr.stats.seconds;
+            r.stats.cpu_seconds = sr.stats.cpu_seconds;
+            r.stats.samples = sr.stats.samples;
+            r.stats.pixels = uint64_t(spec.width) * uint64_t(spec.height);
+            r.stats.rays = r.stats.pixels;  // the slicer has no rays: samples per pixel
+            out.slicer = slicer_stats(sr.stats);
             break;
         }
         case Renderer::Segments: {
-            SegmentRenderer* seg = s.current_segments;
-            seg->set_labels(spec.segments.labels ? *spec.segments.labels : label_table());
-            RenderResult r = seg->render(cam, ro);
-            out.image = std::move(r.image);
-            out.sample_counts = std::move(r.sample_counts);
-            out.stats = r.stats;
-            out.segments = seg->stats();
+            SegmentRenderer& seg = *s.current_segments;
+            seg.set_labels(spec.segments.labels ? *spec.segments.labels : label_table());
+            r = seg.render(cam, render_options(spec, m_threads));
+            out.segments = seg.stats();
             break;
         }
     }
+    out.image = std::move(r.image);
+    out.sample_counts = std::move(r.sample_counts);
+    out.stats = r.stats;
     return out;
 }
 
