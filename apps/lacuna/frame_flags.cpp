@@ -20,6 +20,8 @@ constexpr std::pair<const char*, const char*> kFlags[] = {
     {"structure.octree.leaf_cells", "--leaf"},
     {"structure.leaf_cells", "--leaf"},
     {"structure.bits", "--bits"},
+    {"structure.coalesce_edge", "--coalesce-edge"},
+    {"structure.coalesce", "--coalesce"},
     {"structure", "--accel"},
     {"features.shading", "--shading"},
     {"features.gradient_opacity", "--gradient-opacity"},

@@ -204,6 +204,20 @@ void validate_structure(const Structure& st) {
             if constexpr (std::is_same_v<T, structure::Distance> ||
                           std::is_same_v<T, structure::Chebyshev>)
                 if (v.block < 1 || v.block > 64) fail("structure.block", "expected 1..64 cells");
+            if constexpr (std::is_same_v<T, structure::KdTree>) {  // kd_settings' ranges
+                if (v.max_boxes < 0) fail("structure.max_boxes", "expected >= 0 (0 = every leaf)");
+                if (v.delta < 0) fail("structure.delta", "expected >= 1 cells (0 = from the size)");
+                if (!(v.min_volume >= 0.f && v.min_volume <= 1.f))
+                    fail("structure.min_volume", "expected a fraction in 0..1");
+                if (!(v.min_gain >= 0.f && v.min_gain <= 1.f))
+                    fail("structure.min_gain", "expected a fraction in 0..1");
+                if (v.max_depth < 0 || v.max_depth > 64) fail("structure.max_depth", "expected 0..64");
+            }
+            if constexpr (std::is_same_v<T, structure::GrowingBoxes>) {  // validate(BoxesOptions)'s
+                if (!(v.coalesce <= 1.f))
+                    fail("structure.coalesce", "expected a share <= 1 (negative: off)");
+                if (!(v.coalesce_edge > 0.f)) fail("structure.coalesce_edge", "expected a length > 0 (mm)");
+            }
         },
         st);
 }
