@@ -19,8 +19,10 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <type_traits>
 
 #include "accel/brick_grid.h"
+#include "accel/no_accel.h"
 #include "core/simd_lanes.h"
 #include "lacuna/camera.h"
 #include "lacuna/renderer.h"
@@ -63,6 +65,10 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                          float chunk, float ert, int x0, int y0, int x1, int y1, Policy& policy,
                          uint64_t& tile_samples, uint64_t& tile_rays, March&& march) {
     using Cursor = typename S::Cursor;
+    // Whole rays (NoAccel: one segment [t_near, t_far], the leaping kernels' case): the run is
+    // LatticeRuns' first, computed here without a cursor, and there is never a second.
+    constexpr bool kWhole = std::is_same_v<S, NoAccel>;
+    const float inv_dt = 1.f / dt;
     const Vec3f inv_sp = inverse_spacing(vol);
     const Vec3i dims = vol.dims();
     const float hi[3] = {float(dims.x - 1), float(dims.y - 1), float(dims.z - 1)};
@@ -131,10 +137,18 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                 ++tile_rays;
                 Slot& sl = slot[l];
                 const float t_base = policy.t_base(x, y, t_near);
-                sl.runs.reset();
-                sl.cursor.emplace(accel, cursor_ray(r), t_near, t_far, dt, chunk);
-                sl.runs.emplace(*sl.cursor, t_base, dt, lattice_end(t_base, t_far, dt));
-                if (sl.runs->next(kb, ke)) {
+                const int k_end = lattice_end(t_base, t_far, dt);
+                bool run;
+                if constexpr (kWhole) {
+                    lattice_run(Segment{t_near, t_far}, t_base, inv_dt, 0, k_end, kb, ke);
+                    run = 0 < k_end && ke > kb;
+                } else {
+                    sl.runs.reset();
+                    sl.cursor.emplace(accel, cursor_ray(r), t_near, t_far, dt, chunk);
+                    sl.runs.emplace(*sl.cursor, t_base, dt, k_end);
+                    run = sl.runs->next(kb, ke);
+                }
+                if (run) {
                     sl.x = x, sl.y = y;
                     L.ox[l] = r.ox, L.oy[l] = r.oy, L.oz[l] = r.oz;
                     L.dx[l] = r.dx, L.dy[l] = r.dy, L.dz[l] = r.dz;
@@ -159,7 +173,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
         for (int l = 0; l < W; ++l) {
             if (!(need >> l & 1)) continue;
             int kb, ke;
-            if (!(L.a[l] >= ert) && slot[l].runs->next(kb, ke)) {
+            if (!kWhole && !(L.a[l] >= ert) && slot[l].runs->next(kb, ke)) {
                 L.k[l] = kb, L.kend[l] = ke;
                 continue;
             }

@@ -62,6 +62,12 @@ inline int lattice_end(float t_base, float t_far, float dt) {
 // a whole sample of margin on either side (floor(u - 0.5) and floor(u - 0.5) + 2 for the exact
 // u = (t - t_base) / dt), so u may be off by ulps: it is (t - t_base) * (1 / dt), a multiply
 // where a division sat on the scheduler's critical path.
+// One segment's run, from lattice index k on: [b, e), empty if e <= b.
+inline void lattice_run(const Segment& seg, float t_base, float inv_dt, int k, int k_end, int& b,
+                        int& e) {
+    b = std::max(k, int(std::floor((seg.t0 - t_base) * inv_dt - 0.5f)));
+    e = std::min(k_end, int(std::floor((seg.t1 - t_base) * inv_dt - 0.5f)) + 2);
+}
 template <class Cursor>
 class LatticeRuns {
 public:
@@ -70,8 +76,8 @@ public:
     bool next(int& kb, int& ke) {
         Segment seg;
         while (m_k < m_end && m_cursor.next(seg)) {
-            const int b = std::max(m_k, int(std::floor((seg.t0 - m_t_base) * m_inv_dt - 0.5f)));
-            const int e = std::min(m_end, int(std::floor((seg.t1 - m_t_base) * m_inv_dt - 0.5f)) + 2);
+            int b, e;
+            lattice_run(seg, m_t_base, m_inv_dt, m_k, m_end, b, e);
             m_k = std::max(m_k, e);
             if (e > b) {
                 kb = b;
