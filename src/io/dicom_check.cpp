@@ -24,13 +24,14 @@ bool long_vr(const char* vr) {
     return false;
 }
 
-// The VRs of PS3.5 Table 6.2-1: what GDCM's VR::GetVRType recognises when it guesses the
-// encoding of a file without a file meta group (FileMetaInformation::ReadCompat).
+// What GDCM's VR::GetVRType does not answer VR_END for, when it guesses the encoding of a file
+// without a file meta group (FileMetaInformation::ReadCompat): the VRs of PS3.5 Table 6.2-1
+// and "??" (GDCM 3.0.21's VRStrings, whose entry 0 is "??", VR::INVALID).
 bool known_vr(const uint8_t* p) {
-    static const char* kVr[] = {"AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD", "FL",
-                                "IS", "LO", "LT", "OB", "OD", "OF", "OL", "OV", "OW",
-                                "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM", "UC",
-                                "UI", "UL", "UN", "UR", "US", "UT", "UV"};
+    static const char* kVr[] = {"??", "AE", "AS", "AT", "CS", "DA", "DS", "DT", "FD",
+                                "FL", "IS", "LO", "LT", "OB", "OD", "OF", "OL", "OV",
+                                "OW", "PN", "SH", "SL", "SQ", "SS", "ST", "SV", "TM",
+                                "UC", "UI", "UL", "UN", "UR", "US", "UT", "UV"};
     for (const char* v : kVr)
         if (char(p[0]) == v[0] && char(p[1]) == v[1]) return true;
     return false;
@@ -56,7 +57,8 @@ struct Encoding {
 };
 
 // GDCM's guess for a data set that starts at `h` (8 bytes, `got` of them read) without a file
-// meta group: FileMetaInformation::ReadCompat of GDCM 3.0, branch by branch. False when GDCM
+// meta group: FileMetaInformation::ReadCompat of GDCM 3.0.21 (Debian 12's), branch by branch,
+// checked against its source. False when GDCM
 // gives up on the file ("Cannot find DICOM type") or reads no value of it (implicit big
 // endian, which GDCM refuses).
 bool guess_encoding(const uint8_t* h, size_t got, Encoding& enc) {
@@ -68,12 +70,14 @@ bool guess_encoding(const uint8_t* h, size_t got, Encoding& enc) {
     } else if (g == 0x0800) {  // ACR-NEMA big endian
         if (!vr) return false;
         enc = {true, true};
-    } else if (e == 0x0010) {  // a private creator first: implicit little endian
-        enc = {false, false};
+    } else if (e == 0x0010) {  // a private creator first: little endian
+        enc = {vr, false};
     } else if (vr) {
         enc = {true, g > 0xFF || e > 0xFF};
     } else if (g == 0 && e == 0 && got >= 8 && u32(h + 4, false) == 4) {
-        enc = {false, false};  // a (0000,0000) element of 4 bytes (a crafted file)
+        // A (0000,0000) element of 4 bytes (a crafted file): GDCM guesses again from the next
+        // element and asserts that the answer is implicit little endian; walked as that.
+        enc = {false, false};
     } else {
         return false;
     }

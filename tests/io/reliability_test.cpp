@@ -599,6 +599,10 @@ TEST(IoDicomFolder, HugeLengthInAFileWithoutPreambleIsAnError) {
         {"a private creator first, implicit VR",
          {0x09, 0, 0x10, 0, 0, 0, 0, 0x60, 'x', 'y'},
          "element (0009,0010) says 1610612736 bytes, 2 are left"},
+        {"a private creator first, explicit VR (GDCM 3.0.21 looks for a VR here too)",
+         {0x09, 0, 0x10, 0, 'L', 'O', 4, 0, 'A', 'C', 'M', 'E', 0x09, 0, 0x11, 0, 'O', 'B', 0, 0,
+          0, 0, 0, 0x50},
+         "element (0009,0011) says 1342177280 bytes, 0 are left"},
     };
     for (const Case& c : cases) {
         test::write_bytes(s + "/junk.dcm", c.bytes);
