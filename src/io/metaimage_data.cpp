@@ -109,7 +109,16 @@ MetaHeaderOrientation check_metaimage_header(const std::string& path) {
         const size_t eol = std::min(head.find('\n', pos), head.size());
         const std::string line = head.substr(pos, eol - pos);
         pos = eol + 1;
-        const size_t eq = line.find('=');
+        // MetaIO reads keys as C strings and ends a key at '=' or ':' (MET_Read): a NUL cuts
+        // a key short ("NDims\0..." is NDims to MetaIO), and "NDims: 40000" sets NDims. Both
+        // slipped past this check, and a TransformMatrix then made MetaIO read NDims^2
+        // numbers (fuzz_metaimage: a 530-byte header hung the Release CLI for more than 20 s;
+        // "NDims: 40000" took 8.5 s). So NUL is refused, and ':' separates as '=' does.
+        if (line.find('\0') != std::string::npos)
+            throw Error(path, "header",
+                        "line " + std::to_string(n) +
+                            " holds a NUL byte (expected a text header before ElementDataFile)");
+        const size_t eq = line.find_first_of("=:");
         const std::string key = trim(line.substr(0, eq));
         const std::string value = eq == std::string::npos ? "" : trim(line.substr(eq + 1));
         if (key.size() > kMaxField || value.size() > kMaxField)

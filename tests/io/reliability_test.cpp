@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -252,6 +253,31 @@ TEST(IoMetaImage, OverlongHeaderFieldsAreErrorsNotAborts) {
     EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
     test::write_text(dir.file("endless.mha"), head + std::string(size_t(1) << 20, '\n'));
     EXPECT_NE(read_error(dir.file("endless.mha")).find("no ElementDataFile"), std::string::npos);
+}
+
+// MetaIO ends a key at '=' or ':' and reads it as a C string; a NDims the check did not see
+// (after a NUL, or written "NDims: 40000") made MetaIO read NDims^2 TransformMatrix numbers:
+// a hang (found by fuzz_metaimage, 530 bytes; the Release CLI ran for more than 20 s).
+TEST(IoMetaImage, NDimsMetaIOWouldSeeIsCheckedWhateverItsSeparator) {
+    ScratchDir dir;
+    const std::string tail =
+        "TransformMatrix = 1 0 0 0 1 0 0 0 1\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+        "ElementDataFile = LOCAL\n" +
+        std::string(8, '\0');
+    test::write_text(dir.file("colon.mha"), "ObjectType = Image\nNDims: 40000\n" + tail);
+    test::write_text(dir.file("nul.mha"),
+                     "ObjectType = Image\nNDims" + std::string(20, '\0') + "False\n" + tail);
+    test::write_text(dir.file("ok.mha"), "ObjectType = Image\nNDims: 3\n" + tail);
+    const auto t0 = std::chrono::steady_clock::now();
+    std::string msg = read_error(dir.file("colon.mha"));
+    EXPECT_NE(msg.find("colon.mha: header: expected NDims = 3 (or 4 with a last size of 1), got "
+                       "'40000'"),
+              std::string::npos)
+        << msg;
+    msg = read_error(dir.file("nul.mha"));
+    EXPECT_NE(msg.find("nul.mha: header: line 2 holds a NUL byte"), std::string::npos) << msg;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+    EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
 }
 
 TEST(IoDetached, DataFileOutsideTheHeadersFolderNeedsPermission) {
