@@ -569,11 +569,11 @@ LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data
 // r += w * rgb * a in queue order, which is the ray's sample order. So every pixel has the bits
 // of ShadedStream's, hence of composite_ray's.
 inline constexpr int kShadeRecords = 32;  // rays in flight: the lanes plus the deferred pixels
-// Per ray: colour accumulators, the ray's fixed light (l, v, half vector h, |l + v| > 0), and
-// how many of its samples wait in the queue.
+// Per ray: colour accumulators, the ray's view v, half vector h and |l + v| > 0 (its light l is
+// the frame's: ShadeFrame), and how many of its samples wait in the queue.
 struct ShadeRecords {
     alignas(32) float r[kShadeRecords], g[kShadeRecords], b[kShadeRecords];
-    alignas(32) float l[3][kShadeRecords], v[3][kShadeRecords], h[3][kShadeRecords];
+    alignas(32) float v[3][kShadeRecords], h[3][kShadeRecords];
     alignas(32) int32_t h_ok[kShadeRecords];
     alignas(32) int32_t pending[kShadeRecords];
 };
@@ -594,6 +594,10 @@ struct ShadeFrame {
     const float* const* grad;
     PhongLanes phong;
     float li;
+    // The light's direction l of every record: a directional light's (`dir`), or, for a head
+    // light (head), the record's own view v, so neither is gathered.
+    bool head = true;
+    float dir[3] = {0.f, 0.f, 0.f};
 };
 
 // The directions d[.][rec[l]] of eight records.
@@ -624,8 +628,9 @@ LACUNA_AVX2 void shade_run8(const ShadeFrame& f, const T* data, ShadeQueue& q, i
     const __m256i rec = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(qrec));
     const __m256 h_ok = _mm256_castsi256_ps(
         _mm256_i32gather_epi32(reinterpret_cast<const int*>(R.h_ok), rec, 4));
-    phong8(f.phong, f.li, gather_dir8(R.l, rec), gather_dir8(R.v, rec), gather_dir8(R.h, rec), h_ok,
-           gx, gy, gz, r, g, b, n);
+    const Dir8 v = gather_dir8(R.v, rec);
+    const Dir8 l = f.head ? v : Dir8{_mm256_set1_ps(f.dir[0]), _mm256_set1_ps(f.dir[1]), _mm256_set1_ps(f.dir[2])};
+    phong8(f.phong, f.li, l, v, gather_dir8(R.h, rec), h_ok, gx, gy, gz, r, g, b, n);
     for (int j = 0; j < n; ++j) {
         const int i = qrec[j];
         const float w = q.w[i0 + j], a = q.a[i0 + j];

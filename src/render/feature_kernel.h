@@ -802,9 +802,9 @@ public:
         const Vec3f l = m_c.f->light.kind == LightKind::Head ? view : m_c.light_dir;
         Vec3f h{0, 0, 1};
         m_R.h_ok[i] = shading::half_vector(l, view, h) ? -1 : 0;
-        const Vec3f d[3] = {l, view, h};
-        float(*dst[3])[simd::kShadeRecords] = {m_R.l, m_R.v, m_R.h};
-        for (int q = 0; q < 3; ++q) dst[q][0][i] = d[q].x, dst[q][1][i] = d[q].y, dst[q][2][i] = d[q].z;
+        const Vec3f d[2] = {view, h};  // (l is the frame's: simd::ShadeFrame)
+        float(*dst[2])[simd::kShadeRecords] = {m_R.v, m_R.h};
+        for (int q = 0; q < 2; ++q) dst[q][0][i] = d[q].x, dst[q][1][i] = d[q].y, dst[q][2][i] = d[q].z;
         m_x[i] = x, m_y[i] = y;
     }
     void finish(int lane, int, int, const simd::Lanes& L) {

@@ -245,9 +245,13 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
                     corr_z.push_back(Rgba{});  // the zero entry idle lanes composite
                     simd::ShadeGrid sg_lanes = sg;
                     sg_lanes.cell_mask = nullptr;
-                    const simd::ShadeFrame sf{sg_lanes, &c.raw[0][0].r, c.grad[0] ? c.grad : nullptr,
+                    const simd::ShadeFrame sf{sg_lanes,
+                                              &c.raw[0][0].r,
+                                              c.grad[0] ? c.grad : nullptr,
                                               {f.phong.ambient, f.phong.diffuse, f.phong.specular, f.phong.power},
-                                              f.light.intensity};
+                                              f.light.intensity,
+                                              f.light.kind == LightKind::Head,
+                                              {c.light_dir.x, c.light_dir.y, c.light_dir.z}};
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
                                            feature::Counts n;
