@@ -600,6 +600,25 @@ struct ShadeFrame {
     float dir[3] = {0.f, 0.f, 0.f};
 };
 
+// The per-ray half vectors of eight rays of a RayBatch8 (the shaded lanes' records), with
+// shading::half_vector's operations lane by lane: v = -w, l = `ldir` (a head light: v),
+// h = (l + v) / |l + v| and ok = -1 where |l + v| > 0, else h = (0, 0, 1) and ok = 0.
+LACUNA_AVX2 inline void half_vectors8(const RayBatch8& rb, bool head, const float ldir[3], float (*h)[8],
+                                      int32_t* ok) {
+    const __m256 sign = _mm256_set1_ps(-0.f);
+    const __m256 v[3] = {_mm256_xor_ps(_mm256_load_ps(rb.wx), sign), _mm256_xor_ps(_mm256_load_ps(rb.wy), sign),
+                         _mm256_xor_ps(_mm256_load_ps(rb.wz), sign)};
+    __m256 s[3];
+    for (int a = 0; a < 3; ++a) s[a] = _mm256_add_ps(head ? v[a] : _mm256_set1_ps(ldir[a]), v[a]);
+    const __m256 len = _mm256_sqrt_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(s[0], s[0]), _mm256_mul_ps(s[1], s[1])), _mm256_mul_ps(s[2], s[2])));
+    const __m256 good = _mm256_cmp_ps(len, _mm256_setzero_ps(), _CMP_GT_OQ);
+    const float unit[3] = {0.f, 0.f, 1.f};
+    for (int a = 0; a < 3; ++a)
+        _mm256_store_ps(h[a], _mm256_blendv_ps(_mm256_set1_ps(unit[a]), _mm256_div_ps(s[a], len), good));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(ok), _mm256_castps_si256(good));
+}
+
 // The directions d[.][rec[l]] of eight records.
 LACUNA_AVX2 inline Dir8 gather_dir8(const float (*d)[kShadeRecords], __m256i rec) {
     return {_mm256_i32gather_ps(d[0], rec, 4), _mm256_i32gather_ps(d[1], rec, 4),

@@ -778,7 +778,7 @@ class ShadedLanesPolicy {
 public:
     ShadedLanesPolicy(const Context& c, const simd::ShadeFrame& sf, const T* data, RenderResult& out,
                       const RenderOptions& opt)
-        : m_c(c), m_sf(sf), m_data(data), m_out(out), m_opt(opt) {
+        : m_c(c), m_sf(sf), m_data(data), m_out(out), m_opt(opt), m_empty(empty_pixel_word(opt)) {
         for (int i = 0; i < simd::kShadeRecords; ++i) m_free[i] = simd::kShadeRecords - 1 - i;
         m_nfree = simd::kShadeRecords;
     }
@@ -792,19 +792,20 @@ public:
         const float j = f.jitter ? jitter(uint32_t(x), uint32_t(y), f.jitter_seed) : 0.5f;
         return t_near + (j - 0.5f) * m_c.dt;
     }
-    // ShadedStream's per-ray light: l (the view for a head light), and the half vector.
-    void begin(int lane, int x, int y, Vec3f dir) {
+    // ShadedStream's per-ray light: l (the view for a head light), and the half vector, made
+    // for eight rays at a time as the scheduler sets them up (rays8; `slot` is the ray's).
+    void rays8(const simd::RayBatch8& rb) {
+        const float l[3] = {m_c.light_dir.x, m_c.light_dir.y, m_c.light_dir.z};
+        simd::half_vectors8(rb, m_c.f->light.kind == LightKind::Head, l, m_bh, m_bok);
+    }
+    void begin(int lane, int x, int y, Vec3f dir, int slot) {
         const int i = m_free[--m_nfree];
         m_rec[lane] = i;
         m_R.r[i] = m_R.g[i] = m_R.b[i] = 0.f;
         m_R.pending[i] = 0;
-        const Vec3f view = -dir;
-        const Vec3f l = m_c.f->light.kind == LightKind::Head ? view : m_c.light_dir;
-        Vec3f h{0, 0, 1};
-        m_R.h_ok[i] = shading::half_vector(l, view, h) ? -1 : 0;
-        const Vec3f d[2] = {view, h};  // (l is the frame's: simd::ShadeFrame)
-        float(*dst[2])[simd::kShadeRecords] = {m_R.v, m_R.h};
-        for (int q = 0; q < 2; ++q) dst[q][0][i] = d[q].x, dst[q][1][i] = d[q].y, dst[q][2][i] = d[q].z;
+        m_R.h_ok[i] = m_bok[slot];
+        m_R.v[0][i] = -dir.x, m_R.v[1][i] = -dir.y, m_R.v[2][i] = -dir.z;
+        m_R.h[0][i] = m_bh[0][slot], m_R.h[1][i] = m_bh[1][slot], m_R.h[2][i] = m_bh[2][slot];
         m_x[i] = x, m_y[i] = y;
     }
     void finish(int lane, int, int, const simd::Lanes& L) {
@@ -816,7 +817,7 @@ public:
         else
             m_deferred[m_ndeferred++] = i;
     }
-    void empty(int x, int y) { write_pixel(m_out, m_opt, x, y, kernel::Accum{}, 0); }
+    void empty(int x, int y) { write_empty_pixel(m_out, m_opt, m_empty, x, y); }
     void poll() {
         int kept = 0;
         for (int d = 0; d < m_ndeferred; ++d) {
@@ -844,6 +845,9 @@ private:
     const T* m_data;
     RenderResult& m_out;
     const RenderOptions& m_opt;
+    const uint32_t m_empty;
+    alignas(32) float m_bh[3][8] = {};  // the last ray batch's half vectors (rays8)
+    alignas(32) int32_t m_bok[8] = {};
     simd::ShadeRecords m_R{};
     simd::ShadeQueue m_q{};
     alignas(64) int32_t m_rec[simd::kMaxLanes] = {};

@@ -9,7 +9,9 @@
 //
 // What differs between the kernels is the Policy:
 //   float t_base(int x, int y, float t_near)   the ray's lattice origin (jitter)
-//   void begin(int lane, int x, int y, Vec3f world_dir)   a ray enters a lane
+//   void begin(int lane, int x, int y, Vec3f world_dir, int slot)   a ray enters a lane (slot:
+//       its index in the last ray batch given to rays8, when the policy has one)
+//   void rays8(const simd::RayBatch8&)   optional: each batch of eight rays as it is set up
 //   void finish(int lane, int x, int y, const simd::Lanes&)   its ray is done: pixel or deferral
 //   void empty(int x, int y)   a pixel whose ray has no run at all
 //   void poll()   at every refill (deferred pixels whose shading has completed)
@@ -111,6 +113,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                     px[i] = float(order[j][0]), py[i] = float(order[j][1]);
                 }
                 simd::setup_rays8(cv, px, py, isp, hi, rb);
+                if constexpr (requires { policy.rays8(rb); }) policy.rays8(rb);
             }
             const int i = q - rb_base;
             r = {rb.ox[i], rb.oy[i], rb.oz[i], rb.dx[i], rb.dy[i], rb.dz[i]};
@@ -157,7 +160,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                     L.r[l] = L.g[l] = L.b[l] = L.a[l] = 0.f;
                     L.n[l] = 0;
                     L.active[l] = -1;
-                    policy.begin(l, x, y, dir);
+                    policy.begin(l, x, y, dir, next_pixel - 1 - rb_base);
                     ++live;
                     return;
                 }
@@ -193,12 +196,13 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
 struct CompositePolicy {
     RenderResult& out;
     const RenderOptions& opt;
+    uint32_t empty_word = empty_pixel_word(opt);
     float t_base(int, int, float t_near) const { return t_near; }
-    void begin(int, int, int, Vec3f) {}
+    void begin(int, int, int, Vec3f, int) {}
     void finish(int l, int x, int y, const simd::Lanes& L) {
         write_pixel(out, opt, x, y, kernel::Accum{L.r[l], L.g[l], L.b[l], L.a[l]}, uint32_t(L.n[l]));
     }
-    void empty(int x, int y) { write_pixel(out, opt, x, y, kernel::Accum{}, 0); }
+    void empty(int x, int y) { write_empty_pixel(out, opt, empty_word, x, y); }
     void poll() {}
     void drain() {}
 };

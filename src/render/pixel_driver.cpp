@@ -7,10 +7,9 @@
 
 namespace lacuna {
 
-void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
-                 const kernel::Accum& acc, uint32_t samples) {
+// The RGBA8 word of `acc` over the background.
+static uint32_t pixel_word(const RenderOptions& opt, const kernel::Accum& acc) {
     const float w = 1.f - acc.a;
-    uint8_t* px = out.image.pixel(x, y);
     const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
                           acc.b + w * opt.background.z};
     // std::lround of clamp(c, 0, 1) * 255 per channel, for c in [0, 255] without the libm call:
@@ -24,9 +23,9 @@ void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
     const __m128i r = _mm_sub_epi32(
         t, _mm_castps_si128(_mm_cmpge_ps(_mm_sub_ps(v, _mm_cvtepi32_ps(t)), _mm_set1_ps(0.5f))));
     const __m128i b8 = _mm_packus_epi16(_mm_packus_epi32(r, r), _mm_setzero_si128());
-    const uint32_t word = uint32_t(_mm_cvtsi128_si32(b8));  // alpha: 1 * 255 = 255
-    std::memcpy(px, &word, 4);
+    return uint32_t(_mm_cvtsi128_si32(b8));  // alpha: 1 * 255 = 255
 #else
+    uint8_t px[4];
     for (int c = 0; c < 3; ++c) {
         const float u = rgb[c] > 0.f ? rgb[c] : 0.f;
         const float x = (u < 1.f ? u : 1.f) * 255.f;
@@ -34,7 +33,18 @@ void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
         px[c] = uint8_t(v + int(x - float(v) >= 0.5f));
     }
     px[3] = 255;
+    uint32_t word;
+    std::memcpy(&word, px, 4);
+    return word;
 #endif
+}
+
+uint32_t empty_pixel_word(const RenderOptions& opt) { return pixel_word(opt, kernel::Accum{}); }
+
+void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
+                 const kernel::Accum& acc, uint32_t samples) {
+    const uint32_t word = pixel_word(opt, acc);
+    std::memcpy(out.image.pixel(x, y), &word, 4);
     const size_t p = size_t(y) * size_t(out.image.width) + size_t(x);
     if (opt.keep_float) {
         float* f = &out.rgba_float[p * 4];

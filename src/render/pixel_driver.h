@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "accel/cursor.h"
 #include "core/simd_lanes.h"
@@ -119,5 +120,13 @@ inline void for_each_sample(Cursor& cursor, float t_base, float dt, int k_end, F
 // ~15% of the sample rate; one call per pixel costs nothing measurable.
 void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
                  const kernel::Accum& acc, uint32_t samples);
+
+// The pixel of a ray without samples, write_pixel(out, opt, x, y, Accum{}, 0), with its word
+// computed once per tile (empty_pixel_word(opt)): on a head half the pixels miss the volume.
+uint32_t empty_pixel_word(const RenderOptions& opt);
+inline void write_empty_pixel(RenderResult& out, const RenderOptions& opt, uint32_t word, int x, int y) {
+    std::memcpy(out.image.pixel(x, y), &word, 4);
+    if (opt.keep_float || opt.count_samples) write_pixel(out, opt, x, y, kernel::Accum{}, 0);
+}
 
 }  // namespace lacuna
