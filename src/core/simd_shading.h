@@ -236,9 +236,9 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 voxel_field8(__m256i w,
 // on a face, and float voxels, go through central_gradient lane by lane.
 template <class T>
 LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, const float* py,
-                            const float* pz, float* gx, float* gy, float* gz) {
+                            const float* pz, float* gx, float* gy, float* gz, int n = 8) {
     if constexpr (sizeof(T) > 2) {
-        central_gradients(g, data, px, py, pz, gx, gy, gz, 8);
+        central_gradients(g, data, px, py, pz, gx, gy, gz, n);
     } else {
         const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
         __m256 p[3] = {_mm256_loadu_ps(px), _mm256_loadu_ps(py), _mm256_loadu_ps(pz)}, f[3];
@@ -252,9 +252,10 @@ LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, 
             inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(_mm256_set1_epi32(g.cell[a]), c[a]));
         }
         // Lanes on a face: central_gradient at the end; their rows are read at cell (1, 1, 1).
-        const int faces = ~_mm256_movemask_ps(_mm256_castsi256_ps(inside)) & 0xff;
-        if (faces == 0xff) {
-            central_gradients(g, data, px, py, pz, gx, gy, gz, 8);
+        // Lanes n.. are padding: whatever they hold, never the scalar path.
+        const int faces = ~_mm256_movemask_ps(_mm256_castsi256_ps(inside)) & 0xff & ((1 << n) - 1);
+        if (faces == (1 << n) - 1) {
+            central_gradients(g, data, px, py, pz, gx, gy, gz, n);
             return;
         }
         for (int a = 0; a < 3; ++a) c[a] = _mm256_blendv_epi8(_mm256_set1_epi32(1), c[a], inside);
@@ -634,11 +635,11 @@ LACUNA_AVX2 void shade_run8(const ShadeFrame& f, const T* data, ShadeQueue& q, i
     int32_t* qrec = q.rec + i0;
     for (int j = n; j < 8; ++j)
         qx[j] = qx[n - 1], qy[j] = qy[n - 1], qz[j] = qz[n - 1], qrec[j] = qrec[n - 1];
-    alignas(32) float gx[8], gy[8], gz[8];
+    alignas(32) float gx[8] = {}, gy[8] = {}, gz[8] = {};  // (padding lanes may stay 0)
     if (f.grad)
         volume_gradients8(f.g, f.grad, qx, qy, qz, gx, gy, gz);
     else
-        gradients8(f.g, data, qx, qy, qz, gx, gy, gz);
+        gradients8(f.g, data, qx, qy, qz, gx, gy, gz, n);
     alignas(32) float r[8], g[8], b[8];
     for (int j = 0; j < 8; ++j) {
         const float* c = f.raw + 4 * ptrdiff_t(q.e[i0 + std::min(j, n - 1)]);
