@@ -2,29 +2,36 @@
 // volume on a free port, loads the page in Debian's headless chromium through playwright-core,
 // waits for a frame, drags a TF opacity point, and checks that the image changes, that the
 // overlay reports the TF-change time, that a second tab is served, that the page logged no
-// console errors, and that Ctrl-C (SIGINT) stops the server cleanly. Saves a screenshot of the
-// viewer to --screenshot (default docs/images/viewer.png, the README picture; ctest passes a path in
-// the build folder so a test run leaves the checkout untouched).
+// console errors, and that Ctrl-C (SIGINT) stops the server cleanly. Then patient orientation
+// (issue 14): on a phantom stored LPS, the page's view menu and its clip-plane box give the frames
+// `lacuna render --view ... --clip ...` gives, byte for byte (the frame's JPEG against the CLI's
+// PNG through the server's own encoder, --jpeg). Saves a screenshot of the viewer to --screenshot
+// (default docs/images/viewer.png, the README picture; ctest passes a path in the build folder so
+// a test run leaves the checkout untouched).
 //
 // Usage: node tests/e2e/viewer.e2e.mjs [--lacuna build/lacuna] [--chromium /usr/bin/chromium]
+//                                       [--jpeg build/lacuna_e2e_jpeg]
 //                                       [--screenshot docs/images/viewer.png]
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 
-const args = { lacuna: 'build/lacuna', chromium: '/usr/bin/chromium', screenshot: 'docs/images/viewer.png' };
+const args = { lacuna: 'build/lacuna', chromium: '/usr/bin/chromium', jpeg: 'build/lacuna_e2e_jpeg',
+               screenshot: 'docs/images/viewer.png' };
 for (let i = 2; i + 1 < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
 
 const dir = mkdtempSync(join(tmpdir(), 'lacuna-e2e-'));
 let server = null;
+let server2 = null;  // the orientation part's server (the LPS phantom)
 let browser = null;
 const watchdog = setTimeout(() => fail('timed out after 150 s'), 150_000);
 
 function fail(message) {
   console.error(`e2e.viewer: FAIL: ${message}`);
   if (server) server.kill('SIGKILL');
+  if (server2) server2.kill('SIGKILL');
   if (browser) browser.close().catch(() => {});
   rmSync(dir, { recursive: true, force: true });
   process.exit(1);
@@ -32,19 +39,61 @@ function fail(message) {
 function check(cond, message) { if (!cond) fail(message); else console.log(`ok - ${message}`); }
 
 // The server prints its URL once it listens ("lacuna viewer: http://127.0.0.1:PORT/ ...").
-function startServer(volume) {
+function spawnServer(volume, tf, onStarted) {
   return new Promise((resolve, reject) => {
-    server = spawn(args.lacuna, ['serve', volume, '--port', '0', '--tf', 'mr-default'],
-                   { stdio: ['ignore', 'pipe', 'pipe'] });
+    const s = spawn(args.lacuna, ['serve', volume, '--port', '0', '--tf', tf],
+                    { stdio: ['ignore', 'pipe', 'pipe'] });
+    onStarted(s);
     let out = '';
-    server.stdout.on('data', (d) => {
+    s.stdout.on('data', (d) => {
       out += d;
       const m = out.match(/lacuna viewer: (http:\/\/127\.0\.0\.1:\d+\/)/);
       if (m) resolve(m[1]);
     });
-    server.stderr.on('data', (d) => process.stderr.write(d));
-    server.on('exit', (code) => reject(new Error(`lacuna serve exited with ${code}: ${out}`)));
+    s.stderr.on('data', (d) => process.stderr.write(d));
+    s.on('exit', (code) => reject(new Error(`lacuna serve exited with ${code}: ${out}`)));
   });
+}
+const startServer = (volume) => spawnServer(volume, 'mr-default', (s) => { server = s; });
+
+// An asymmetric head phantom stored LPS (tests/render/orientation_test_util.h's, in a NRRD
+// written here): voxel i runs toward the patient's left, j posterior, k superior; in world
+// (RAS mm, centred on 0) a faint body (50), a marker on the patient's right (220), one in front
+// (160), one on top (100). Mirrored or permuted handling shows as another picture.
+function writeLpsPhantom(path) {
+  const [nx, ny, nz] = [41, 49, 37], sp = [1, 1.25, 1.5];
+  // LPS position of voxel (0,0,0), RAS (20, 30, -27): the right-anterior-inferior corner.
+  const origin = [-20, -30, -27];
+  const bump = (d, r, v) => v * Math.min(1, Math.max(0, (r - d) / 2.5));
+  const data = Buffer.alloc(nx * ny * nz);
+  for (let k = 0; k < nz; k++) for (let j = 0; j < ny; j++) for (let i = 0; i < nx; i++) {
+    // LPS (origin + index * spacing) -> RAS: x and y negated.
+    const x = -(origin[0] + i * sp[0]), y = -(origin[1] + j * sp[1]), z = origin[2] + k * sp[2];
+    const body = Math.sqrt(x * x / 256 + y * y / 484 + z * z / 400);
+    let v = 50 * Math.min(1, Math.max(0, (1 - body) * 5));
+    v = Math.max(v, bump(Math.hypot(x - 11, y + 2, z), 5, 220));
+    v = Math.max(v, bump(Math.hypot(x, y - 17, z + 4), 4.5, 160));
+    v = Math.max(v, bump(Math.hypot(x + 3, y + 4, z - 16), 4.5, 100));
+    data[(k * ny + j) * nx + i] = Math.round(v);
+  }
+  const header = 'NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\n' +
+    `sizes: ${nx} ${ny} ${nz}\nspace directions: (${sp[0]},0,0) (0,${sp[1]},0) (0,0,${sp[2]})\n` +
+    'kinds: domain domain domain\nencoding: raw\n' +
+    `space origin: (${origin[0]},${origin[1]},${origin[2]})\n\n`;
+  writeFileSync(path, Buffer.concat([Buffer.from(header, 'ascii'), data]));
+}
+// A faint grey body and, opaque, only the right marker (220) in red: where the patient's right is
+// shows in the picture.
+const kPhantomTf = {
+  name: 'right-marker', domain: 'value',
+  color: [[0, 0.5, 0.5, 0.5], [60, 0.5, 0.5, 0.5], [190, 1.0, 0.1, 0.1], [255, 1.0, 0.1, 0.1]],
+  opacity: [[0, 0], [35, 0], [45, 0.03], [60, 0.03], [70, 0], [190, 0], [200, 0.9], [255, 0.9]],
+};
+
+// A binary frame: u32 LE header length, the JSON header, the JPEG (docs/viewer.md, Protocol).
+function parseFrame(buf) {
+  const n = buf.readUInt32LE(0);
+  return { header: JSON.parse(buf.subarray(4, 4 + n).toString('utf8')), jpeg: buf.subarray(4 + n) };
 }
 
 // Waits for a full-resolution frame newer than `after` frames.
@@ -134,6 +183,120 @@ try {
   await waitFullFrame(page2, 0);
   check(true, 'a second tab gets its own frames');
   await page2.close();
+
+  // Patient orientation (issue 14): a phantom stored LPS in a server of its own. The page's view
+  // menu and its clip-plane box, used as a user would, send requests whose frames are the JPEGs
+  // of `lacuna render --view V --clip ...` on the same file with the settings the page sent.
+  {
+    const phantom = join(dir, 'phantom-lps.nrrd'), tfFile = join(dir, 'phantom.json');
+    writeLpsPhantom(phantom);
+    writeFileSync(tfFile, JSON.stringify(kPhantomTf));
+    const url2 = await spawnServer(phantom, tfFile, (s) => { server2 = s; });
+    const page3 = await context.newPage();
+    page3.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+    page3.on('pageerror', (e) => consoleErrors.push(String(e)));
+    // What the page sent and what it got, as they went over its WebSocket, by request id.
+    const sent = new Map(), received = new Map();
+    page3.on('websocket', (ws) => {
+      ws.on('framesent', (f) => {
+        if (typeof f.payload !== 'string') return;
+        const m = JSON.parse(f.payload);
+        if (m.type === 'render') sent.set(m.id, m);
+      });
+      ws.on('framereceived', (f) => {
+        if (typeof f.payload === 'string') return;
+        const fr = parseFrame(Buffer.from(f.payload));
+        received.set(fr.header.id, fr);
+      });
+    });
+    await page3.goto(url2);
+    await waitFullFrame(page3, 0);
+    // The newest full-resolution frame and the request it answers.
+    const latest = () => {
+      const id = Math.max(...[...received.values()].filter((f) => !f.header.preview).map((f) => f.header.id));
+      return { req: sent.get(id), frame: received.get(id) };
+    };
+    // The CLI's image for a request, through the server's JPEG encoder.
+    const cliJpeg = (req, planes) => {
+      const tag = `${req.id}-${planes.length}-${planes.flat().join('_')}`;
+      const tf = join(dir, `tf-${tag}.json`), png = join(dir, `cli-${tag}.png`), jpg = join(dir, `cli-${tag}.jpg`);
+      writeFileSync(tf, JSON.stringify(req.tf));
+      const flags = ['render', phantom, '--tf', tf, '--renderer', req.renderer, '--accel', req.accel,
+                     '--width', String(req.width), '--height', String(req.height),
+                     '--view', req.camera.view, '--zoom', String(req.camera.zoom), '--step', String(req.step),
+                     '--ert', req.ert ? '0.99' : '1'];
+      for (const p of planes) flags.push(`--clip=${p.join(',')}`);
+      execFileSync(args.lacuna, [...flags, '--out', png], { stdio: 'ignore' });
+      execFileSync(args.jpeg, [png, jpg], { stdio: 'ignore' });
+      return readFileSync(jpg);
+    };
+    // The red right marker's pixels in the page's image, and their mean x (a fraction of the width).
+    const redMarker = () => page3.evaluate(() => {
+      const im = document.getElementById('frame');
+      const c = document.createElement('canvas');
+      c.width = im.naturalWidth;
+      c.height = im.naturalHeight;
+      const g = c.getContext('2d');
+      g.drawImage(im, 0, 0);
+      const d = g.getImageData(0, 0, c.width, c.height).data;
+      let n = 0, sx = 0;
+      for (let p = 0; p < d.length; p += 4) {
+        if (d[p] > 150 && d[p + 1] < 90 && d[p + 2] < 90) { n++; sx += (p / 4) % c.width; }
+      }
+      return { n, x: n ? sx / n / c.width : 0.5 };
+    });
+    const firstFrame = latest().frame.jpeg;
+    const steps = [
+      { view: 'left', clip: '' },
+      { view: 'anterior', clip: '' },
+      { view: 'anterior', clip: '-1,0,0,0' },
+      { view: 'superior', clip: '-1,0,0,0; 0,0,-1,-4' },
+    ];
+    let previous = null;
+    for (const st of steps) {
+      // As a user: type the planes (Enter commits the box), pick the view from the menu.
+      if (st.clip !== await page3.inputValue('#clip-planes')) {
+        const n = await page3.evaluate(() => window.lacunaViewer.frames());
+        await page3.fill('#clip-planes', st.clip);
+        await page3.press('#clip-planes', 'Enter');
+        await waitFullFrame(page3, n);
+      }
+      if (st.view !== await page3.inputValue('#view-name')) {
+        const n = await page3.evaluate(() => window.lacunaViewer.frames());
+        await page3.selectOption('#view-name', st.view);
+        await waitFullFrame(page3, n);
+      }
+      const { req, frame } = latest();
+      const planes = st.clip ? st.clip.split(';').map((t) => t.split(',').map(Number)) : [];
+      check(req.camera.view === st.view && req.camera.azimuth === undefined &&
+            JSON.stringify(req.clip_planes) === JSON.stringify(planes),
+            `the page sends view ${st.view} by name with clip planes ${JSON.stringify(req.clip_planes)}`);
+      check(frame.header.width === req.width && frame.header.height === req.height && !(frame.header.reduced > 1),
+            `the frame has the requested size (${req.width}x${req.height})`);
+      const cli = cliJpeg(req, planes);
+      check(Buffer.compare(frame.jpeg, cli) === 0,
+            `view ${st.view}${st.clip ? ', clip ' + st.clip : ''}: the frame is lacuna render's image byte for byte`);
+      check(Buffer.compare(frame.jpeg, previous || firstFrame) !== 0, 'and it differs from the frame before it');
+      previous = frame.jpeg;
+      if (st.view === 'anterior') {
+        // Seen from the front the patient's right is on the screen's left; keeping x <= 0 (RAS)
+        // removes it, whatever the file's voxel order.
+        const red = await redMarker();
+        if (!st.clip) check(red.n > 20 && red.x < 0.5, `the right marker shows on the screen's left (${red.n} px at ${red.x.toFixed(2)})`);
+        else check(red.n === 0, `the clip plane x <= 0 removes the patient's right (${red.n} red px)`);
+        if (st.clip) {
+          check(Buffer.compare(frame.jpeg, cliJpeg(req, [[1, 0, 0, 0]])) !== 0,
+                'the mirrored plane gives another picture (the comparison sees the side)');
+        }
+      }
+    }
+    await page3.close();
+    server2.removeAllListeners('exit');
+    const exited2 = new Promise((resolve) => server2.once('exit', (code) => resolve(code)));
+    server2.kill('SIGINT');
+    check(await exited2 === 0, 'the orientation server stops cleanly');
+    server2 = null;
+  }
 
   await page.screenshot({ path: args.screenshot });
   console.log(`wrote ${args.screenshot}`);
