@@ -26,6 +26,7 @@
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
 #include "partition_boxes.h"
+#include "partition_frame.h"
 
 namespace lacuna::cli {
 
@@ -155,12 +156,21 @@ constexpr Rgb kPalette[] = {{255, 64, 64},  {64, 220, 64},  {80, 140, 255}, {255
 
 // ---- JSON ------------------------------------------------------------------------------------
 
-nlohmann::json box_json(const CellBox& b, uint64_t non_empty) {
-    // Cells [lo, hi) are voxels lo..hi (index coordinates of the box's corners).
-    return {{"lo", {b.lo[0], b.lo[1], b.lo[2]}},
-            {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
-            {"cells", box_volume(b)},
-            {"non_empty_cells", non_empty}};
+// A box of the RAS-order copy in the file's voxel index (cells [lo, hi) are voxels lo..hi), with
+// its world (RAS mm) bounding box.
+nlohmann::json box_json(const CellBox& box, uint64_t non_empty, const Volume& file,
+                        const RasOrder& o) {
+    const CellBox b = to_file_cells(box, o, file.dims());
+    double lo[3], hi[3];
+    world_box(file, b, lo, hi);
+    auto mm = [](double x) { return std::round(x * 1e6) / 1e6 + 0.0; };
+    return {
+        {"lo", {b.lo[0], b.lo[1], b.lo[2]}},
+        {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
+        {"cells", box_volume(b)},
+        {"non_empty_cells", non_empty},
+        {"world",
+         {{"lo", {mm(lo[0]), mm(lo[1]), mm(lo[2])}}, {"hi", {mm(hi[0]), mm(hi[1]), mm(hi[2])}}}}};
 }
 
 double ms(double s) {
@@ -221,6 +231,10 @@ void run(const PartitionArgs& a) {
     const TransferFunction tf = resolve_transfer_function(a.tf);
     const Volume vol = load_volume(a.volume);
     const TransferLut lut = discretise(tf, vol.vis_range());
+    // The partition is built on the voxels in RAS order (partition_frame.h), so the same anatomy
+    // in any voxel order gives the same boxes; the picture under them is rendered from the file.
+    const RasOrder order = ras_order(vol);
+    const Volume ras = order.identity() ? vol : reorder(vol, order);
 
     if (a.repeat < 1 || a.repeat > 1000) throw Error("--repeat", "repeat", "expected 1..1000");
     // Steps 1-4, `repeat` times (the table is reused, as on a TF change); the median of each
@@ -229,9 +243,9 @@ void run(const PartitionArgs& a) {
     std::vector<KdTimings> runs;
     for (int r = 0; r < a.repeat; ++r) {
         if (a.threshold)
-            part.build_from_threshold(vol, *a.threshold, settings);
+            part.build_from_threshold(ras, *a.threshold, settings);
         else
-            part.build_from_tf(vol, lut, settings);
+            part.build_from_tf(ras, lut, settings);
         runs.push_back(part.timings());
     }
     auto median = [&](double KdTimings::*field) {
@@ -252,11 +266,13 @@ void run(const PartitionArgs& a) {
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
     const Camera cam = Camera::orbit(marcher.bounds(), op, a.size, a.size);  // world (RAS)
-    // The boxes live in the volume frame (index * spacing): project and order them there.
-    const Camera vcam = to_volume_frame(volume_frame(vol), cam);
-    const Vec3f eye_index{float(vcam.eye().x / vol.spacing.x), float(vcam.eye().y / vol.spacing.y),
-                          float(vcam.eye().z / vol.spacing.z)};
+    // The boxes live in the RAS-order copy's volume frame (index * spacing): project and order
+    // them there.
+    const Camera vcam = to_volume_frame(volume_frame(ras), cam);
+    const Vec3f eye_index{float(vcam.eye().x / ras.spacing.x), float(vcam.eye().y / ras.spacing.y),
+                          float(vcam.eye().z / ras.spacing.z)};
     const std::vector<CellBox> boxes = part.boxes_in_visibility_order(eye_index);
+    const Vec3f eye_file = to_file_index(eye_index, order, vol.dims());
 
     const Vec3i d = vol.dims();
     const int leaves = part.nodes().empty() ? 0 : part.nodes()[0].leaves;
@@ -283,7 +299,7 @@ void run(const PartitionArgs& a) {
         nlohmann::json j;
         j["volume"] = a.volume.path;
         j["dims"] = {d.x, d.y, d.z};
-        j["cells"] = {part.cells()[0], part.cells()[1], part.cells()[2]};
+        j["cells"] = {d.x - 1, d.y - 1, d.z - 1};
         j["spacing"] = {vol.spacing.x, vol.spacing.y, vol.spacing.z};
         j["method"] = a.method;
         j["classification"] = a.threshold ? "threshold" : "tf";
@@ -308,14 +324,17 @@ void run(const PartitionArgs& a) {
         j["empty_space_removed_percent"] = 100 * part.removed_empty_fraction();
         j["view"] = {{"azimuth", a.azimuth},
                      {"elevation", a.elevation},
-                     {"eye_index", {eye_index.x, eye_index.y, eye_index.z}}};
-        j["box_coordinates"] = "voxel index: a box spans voxels lo..hi (cells [lo, hi))";
+                     {"eye_index", {eye_file.x, eye_file.y, eye_file.z}}};
+        j["box_coordinates"] =
+            "voxel index of the file: a box spans voxels lo..hi (cells [lo, hi)); world: their "
+            "bounding box in patient RAS mm";
+        j["ras_order"] = to_string(order);
         nlohmann::json list = nlohmann::json::array();
         for (const CellBox& b : boxes) {
             uint64_t ne = 0;
             for (const KdNode& n : part.nodes())
                 if (std::memcmp(&n.box, &b, sizeof b) == 0) ne = n.non_empty;
-            list.push_back(box_json(b, ne));
+            list.push_back(box_json(b, ne, vol, order));
         }
         j["boxes"] = list;
         io::write_text_atomic(a.json, j.dump(2) + "\n");
@@ -335,7 +354,7 @@ void run(const PartitionArgs& a) {
         const Projector proj(vcam);
         const int w = a.size >= 384 ? 2 : 1;
         for (size_t i = 0; i < boxes.size(); ++i)
-            draw_box(r.image, proj, boxes[i], vol.spacing, w, kPalette[i % std::size(kPalette)]);
+            draw_box(r.image, proj, boxes[i], ras.spacing, w, kPalette[i % std::size(kPalette)]);
         write_png(a.out, r.image);
         std::printf("wrote %s (%dx%d, render %.1f ms)\n", a.out.c_str(), a.size, a.size,
                     r.stats.seconds * 1e3);

@@ -12,6 +12,7 @@
 #include "lacuna/image.h"
 #include "lacuna/orientation.h"
 #include "lacuna/transfer_function.h"
+#include "partition_frame.h"
 #include "slice/growing_boxes_source.h"
 
 namespace lacuna::cli {
@@ -39,75 +40,34 @@ struct Rgb {
 // The paper's colours: red uniform, blue gradient, green other (indexed by BoxType).
 constexpr Rgb kTypeColour[3] = {{235, 50, 50}, {70, 120, 255}, {40, 200, 60}};
 
-// How the picture lies in the anatomy (issue 14): the slice is across the index axis nearest the
-// patient's superior-inferior axis (an axial slice), seen from above with the patient's right to
-// the right of the screen and anterior up. The panel's columns and rows follow the index axes
-// nearest RAS x and y, reversed where they point left or posterior, so the same anatomy stored
-// in another voxel order (RAS, LPS, a permuted order) gives the same slice picture. A volume
-// without geometry is RAS: x right, y up, z the slice, as before orientation existed.
-struct SliceAxes {
-    int u = 0, v = 1, s = 2;  // index axes: screen right, screen up, across
-    bool flip_u = false, flip_v = false, flip_s = false;  // reversed against RAS +x, +y, +z
-};
-SliceAxes slice_axes(const Volume& vol) {
-    const Affine a = index_to_world(vol);
-    SliceAxes ax;
-    auto nearest = [&](int row, const bool* taken) {  // the free index axis most along RAS `row`
-        int best = -1;
-        for (int c = 0; c < 3; ++c)
-            if (!taken[c] && (best < 0 || std::abs(a.m[row][c]) / a.column_length(c) >
-                                              std::abs(a.m[row][best]) / a.column_length(best)))
-                best = c;
-        return best;
-    };
-    bool taken[3] = {false, false, false};
-    ax.s = nearest(2, taken);
-    taken[ax.s] = true;
-    ax.u = nearest(0, taken);
-    taken[ax.u] = true;
-    ax.v = nearest(1, taken);
-    ax.flip_s = a.m[2][ax.s] < 0;
-    ax.flip_u = a.m[0][ax.u] < 0;
-    ax.flip_v = a.m[1][ax.v] < 0;
-    return ax;
-}
-
+// How the picture lies in the anatomy (issue 14): everything here is built on the voxels in RAS
+// order (partition_frame.h), so the slice is across the superior axis (an axial slice), seen from
+// above with the patient's right to the right of the screen and anterior up: panel columns are
+// index x, rows index y (up), the slice a z layer. The same anatomy in another voxel order (RAS,
+// LPS, a permuted order) gives the same voxels there, hence the same boxes and the same picture.
+// A volume without geometry is RAS already: x right, y up, z the slice, as before orientation
+// existed.
 struct Panel {
     Image& img;
-    int x0, scale, cu, cv;  // panel origin in the image, pixels per cell, cells along u and v
-    SliceAxes ax;
+    int x0, scale, cu, cv;  // panel origin in the image, pixels per cell, cells along x and y
     void px(int x, int y, Rgb c) const {
         if (x < 0 || y < 0 || x >= img.width || y >= img.height) return;
         uint8_t* p = img.pixel(x, y);
         p[0] = c.r, p[1] = c.g, p[2] = c.b, p[3] = 255;
     }
-    // Screen coordinates (0..cu right, 0..cv up) of index coordinates along u and v.
-    int su(int i) const { return ax.flip_u ? cu - i : i; }
-    int sv(int j) const { return ax.flip_v ? cv - j : j; }
-    // Screen cell coordinates to pixels; y up.
+    // Cell coordinates (0..cu right, 0..cv up) to pixels; y up.
     int X(int x) const { return x0 + x * scale; }
     int Y(int y) const { return (cv - y) * scale; }
-    // A box's extent on the screen: [lo, hi] in screen cell coordinates along u and v.
-    void extent(const CellBox& b, int& ua, int& ub, int& va, int& vb) const {
-        ua = std::min(su(b.lo[ax.u]), su(b.hi[ax.u]));
-        ub = std::max(su(b.lo[ax.u]), su(b.hi[ax.u]));
-        va = std::min(sv(b.lo[ax.v]), sv(b.hi[ax.v]));
-        vb = std::max(sv(b.lo[ax.v]), sv(b.hi[ax.v]));
-    }
     void rect(const CellBox& b, Rgb c) const {
-        int ua, ub, va, vb;
-        extent(b, ua, ub, va, vb);
-        const int xa = X(ua), xb = std::max(X(ub) - 1, xa);
-        const int ya = Y(vb), yb = std::max(Y(va) - 1, ya);
+        const int xa = X(b.lo[0]), xb = std::max(X(b.hi[0]) - 1, xa);
+        const int ya = Y(b.hi[1]), yb = std::max(Y(b.lo[1]) - 1, ya);
         for (int x = xa; x <= xb; ++x) px(x, ya, c), px(x, yb, c);
         for (int y = ya; y <= yb; ++y) px(xa, y, c), px(xb, y, c);
     }
     // Tints a box's inside dark violet (boxes the source skips under the TF).
     void tint(const CellBox& b) const {
-        int ua, ub, va, vb;
-        extent(b, ua, ub, va, vb);
-        for (int y = Y(vb); y < Y(va); ++y)
-            for (int x = X(ua); x < X(ub); ++x) {
+        for (int y = Y(b.hi[1]); y < Y(b.lo[1]); ++y)
+            for (int x = X(b.lo[0]); x < X(b.hi[0]); ++x) {
                 if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
                 uint8_t* p = img.pixel(x, y);
                 p[0] = uint8_t((p[0] + 90) / 3), p[1] = uint8_t(p[1] / 3),
@@ -116,33 +76,30 @@ struct Panel {
     }
 };
 
-// `k`: the cell layer across ax.s, in index order.
-Image figure2(const Volume& vol, const GrowingBoxesSource& src, const SliceAxes& ax, int k,
-              int size) {
+// `vol` in RAS order, `src` built on it; `k`: the z cell layer (from the inferior end).
+Image figure2(const Volume& vol, const GrowingBoxesSource& src, int k, int size) {
     const Vec3i d = vol.dims();
-    const int cu = d[ax.u] - 1, cv = d[ax.v] - 1;
+    const int cu = d.x - 1, cv = d.y - 1;
     const int scale = std::max(1, size / std::max(cu, cv));
     const int gap = 8;
     Image img(2 * cu * scale + gap + 1, cv * scale + 1);
     for (size_t i = 0; i < img.rgba.size(); i += 4)
         img.rgba[i] = img.rgba[i + 1] = img.rgba[i + 2] = 0, img.rgba[i + 3] = 255;
     const ValueRange vis = vol.vis_range();
-    const Panel left{img, 0, scale, cu, cv, ax}, right{img, cu * scale + gap, scale, cu, cv, ax};
-    // The voxel plane on the layer's inferior side in grey (the visualization range), nearest
-    // voxel per pixel: index plane k, or k + 1 when the axis runs downward.
+    const Panel left{img, 0, scale, cu, cv}, right{img, cu * scale + gap, scale, cu, cv};
+    // The voxel plane z = k (the layer's inferior side) in grey (the visualization range),
+    // nearest voxel per pixel.
     for (const Panel* p : {&left, &right})
         for (int y = 0; y < cv * scale; ++y)
             for (int x = 0; x < cu * scale; ++x) {
-                int idx[3];
-                idx[ax.s] = ax.flip_s ? k + 1 : k;
-                idx[ax.u] = p->su(std::min(cu, (x + scale / 2) / scale));
-                idx[ax.v] = p->sv(cv - (y + scale / 2) / scale);
-                const float t =
-                    (vol.value(idx[0], idx[1], idx[2]) - vis.min) / std::max(vis.width(), 1e-30f);
+                const float t = (vol.value(std::min(cu, (x + scale / 2) / scale),
+                                           cv - (y + scale / 2) / scale, k) -
+                                 vis.min) /
+                                std::max(vis.width(), 1e-30f);
                 const uint8_t g = uint8_t(std::clamp(t, 0.f, 1.f) * 200.f);
                 p->px(p->x0 + x, y, Rgb{g, g, g});
             }
-    auto crosses = [&](const CellBox& b) { return b.lo[ax.s] <= k && k < b.hi[ax.s]; };
+    auto crosses = [&](const CellBox& b) { return b.lo[2] <= k && k < b.hi[2]; };
     // (a) the grown boxes.
     for (const BoxInfo& b : src.grown())
         if (crosses(b.box)) left.rect(b.box, kTypeColour[int(b.type)]);
@@ -158,27 +115,37 @@ Image figure2(const Volume& vol, const GrowingBoxesSource& src, const SliceAxes&
     return img;
 }
 
-nlohmann::json box_json(const CellBox& b) {
-    return {{"lo", {b.lo[0], b.lo[1], b.lo[2]}},
-            {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
-            {"cells", box_volume(b)}};
+// A box of the RAS-order copy in the file's voxel index coordinates, with its world box.
+nlohmann::json box_json(const CellBox& box, const Volume& file, const RasOrder& o) {
+    const CellBox b = to_file_cells(box, o, file.dims());
+    double lo[3], hi[3];
+    world_box(file, b, lo, hi);
+    auto mm = [](double x) { return std::round(x * 1e6) / 1e6 + 0.0; };
+    return {
+        {"lo", {b.lo[0], b.lo[1], b.lo[2]}},
+        {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
+        {"cells", box_volume(b)},
+        {"world",
+         {{"lo", {mm(lo[0]), mm(lo[1]), mm(lo[2])}}, {"hi", {mm(hi[0]), mm(hi[1]), mm(hi[2])}}}}};
 }
 
 }  // namespace
 
-void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
+void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& file) {
     validate(a.options);
     if (a.repeat < 1 || a.repeat > 1000) throw Error("--repeat", "repeat", "expected 1..1000");
-    const Vec3i d = vol.dims();
-    // --slice counts axial cell layers from the inferior end (the same anatomy in any voxel
-    // order); k is the layer in index order.
-    const SliceAxes ax = slice_axes(vol);
-    const int layers = d[ax.s] - 1;
+    const Vec3i d = file.dims();
+    // Everything below is built on the voxels in RAS order (partition_frame.h): the boxes, their
+    // tree and the picture are then the same for the same anatomy in any voxel order. Only the
+    // JSON's voxel coordinates go back to the file's index.
+    const RasOrder order = ras_order(file);
+    const Volume vol = order.identity() ? file : reorder(file, order);
+    // --slice counts axial cell layers from the inferior end: the z layer of the RAS order.
+    const int layers = vol.dims().z - 1;
     const int slice = a.slice < 0 ? layers / 2 : a.slice;
     if (slice >= layers)
         throw Error("--slice", "cell layer",
                     "expected 0.." + std::to_string(layers - 1) + ", got " + std::to_string(slice));
-    const int k = ax.flip_s ? layers - 1 - slice : slice;
     const TransferFunction tf = resolve_transfer_function(a.tf);
     const TransferLut lut = discretise(tf, vol.vis_range());
 
@@ -213,9 +180,10 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
     const Camera cam =
-        to_volume_frame(volume_frame(vol), Camera::orbit(world_bounds(vol), op, 64, 64));
+        to_volume_frame(volume_frame(vol), Camera::orbit(world_bounds(file), op, 64, 64));
     const Vec3f eye{float(cam.eye().x / vol.spacing.x), float(cam.eye().y / vol.spacing.y),
                     float(cam.eye().z / vol.spacing.z)};
+    const Vec3f eye_file = to_file_index(eye, order, d);
 
     uint64_t visible_cells = 0;
     for (int32_t id : src->leaves())
@@ -248,7 +216,7 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
         j["volume"] = a.volume_path;
         j["dims"] = {d.x, d.y, d.z};
         j["cells"] = {d.x - 1, d.y - 1, d.z - 1};
-        j["spacing"] = {vol.spacing.x, vol.spacing.y, vol.spacing.z};
+        j["spacing"] = {file.spacing.x, file.spacing.y, file.spacing.z};
         j["method"] = "boxes";
         j["tf"] = tf.name;
         const BoxesOptions& o = a.options;
@@ -282,21 +250,24 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
         j["visible_cells"] = visible_cells;
         j["view"] = {{"azimuth", a.azimuth},
                      {"elevation", a.elevation},
-                     {"eye_index", {eye.x, eye.y, eye.z}}};
-        j["box_coordinates"] = "voxel index: a box spans voxels lo..hi (cells [lo, hi))";
+                     {"eye_index", {eye_file.x, eye_file.y, eye_file.z}}};
+        j["box_coordinates"] =
+            "voxel index of the file: a box spans voxels lo..hi (cells [lo, hi)); world: their "
+            "bounding box in patient RAS mm";
+        j["ras_order"] = to_string(order);
         nlohmann::json grown = nlohmann::json::array();
         for (const BoxInfo& b : src->grown()) {
-            nlohmann::json e = box_json(b.box);
+            nlohmann::json e = box_json(b.box, file, order);
             e["type"] = to_string(b.type);
             grown.push_back(e);
         }
         j["grown_boxes"] = grown;
         // Every final leaf, front to back for the view; "empty" ones are skipped by the source.
-        std::vector<int32_t> order;
-        src->tree().order(eye, order);
+        std::vector<int32_t> front_to_back;
+        src->tree().order(eye, front_to_back);
         nlohmann::json list = nlohmann::json::array();
-        for (int32_t id : order) {
-            nlohmann::json e = box_json(src->tree().boxes()[size_t(id)].box);
+        for (int32_t id : front_to_back) {
+            nlohmann::json e = box_json(src->tree().boxes()[size_t(id)].box, file, order);
             e["type"] = to_string(src->info(id).type);
             e["empty"] = src->empty(id);
             e["parent"] = src->tree().parent_of(id);
@@ -307,13 +278,14 @@ void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol) {
         std::printf("wrote %s\n", a.json.c_str());
     }
     if (!a.out.empty()) {
-        const Image img = figure2(vol, *src, ax, k, a.size);
+        const Image img = figure2(vol, *src, slice, a.size);
         write_png(a.out, img);
+        const int axis = order.axis[2], layer = order.flip[2] ? layers - 1 - slice : slice;
         std::printf(
             "wrote %s (%dx%d, axial slice %d from inferior = index %c %d, seen from above, "
             "patient's right to the right: grown boxes left, BSP leaves right; red uniform, blue "
             "gradient, green other; tinted violet: empty under the TF)\n",
-            a.out.c_str(), img.width, img.height, slice, "xyz"[ax.s], k);
+            a.out.c_str(), img.width, img.height, slice, "xyz"[axis], layer);
     }
 }
 

@@ -13,13 +13,14 @@ namespace lacuna::cli {
 struct PartitionBoxesArgs {
     std::string volume_path, tf, json, out;
     BoxesOptions options;
-    int slice = -1;  // cell layer in z for the picture (-1: the middle)
+    int slice = -1;  // the picture's axial cell layer from the inferior end (-1: the middle)
     int size = 512;  // picture: each panel's longer side is about this many pixels
     float azimuth = 30.f, elevation = 20.f;  // the view whose visibility order the JSON lists
     int repeat = 1;                          // builds; median step times are reported
 };
 
-// `vol` is loaded (and its --range applied) by the caller.
-void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& vol);
+// `file` is loaded (and its --range applied) by the caller. The boxes are built on its voxels in
+// RAS order (partition_frame.h), so one anatomy gives one set of boxes whatever the voxel order.
+void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& file);
 
 }  // namespace lacuna::cli

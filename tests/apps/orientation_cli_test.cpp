@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -206,11 +207,11 @@ TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng)
 }
 
 // Orientation round-trips through `partition` (issue 14, item 6): the phantom stored RAS, LPS
-// and in a sagittal PIR order gives the same kd-tree overlay, byte for byte (the boxes are drawn
-// through the volume-frame camera of the render under them), the same slice-renderer picture, and
-// the same slice in the growing-boxes figure, which shows the axial slice from above with the
-// patient's right to the right: the right marker lies in the right half of the left panel in
-// every storage.
+// and in a sagittal PIR order gives the same kd-tree overlay, byte for byte (the boxes are built
+// on the voxels in RAS order and drawn through that copy's volume-frame camera over the file's
+// render), the same slice-renderer picture, and the same growing-boxes figure, byte for byte,
+// which shows the axial slice from above with the patient's right to the right: the right marker
+// lies in the right half of the left panel in every storage.
 TEST(OrientationCli, PartitionOverlaysAndSliceRendersShowOneAnatomyInEveryStorage) {
     namespace to = lacuna::test::orientation;
     const lacuna::Volume base = to::phantom();
@@ -257,29 +258,105 @@ TEST(OrientationCli, PartitionOverlaysAndSliceRendersShowOneAnatomyInEveryStorag
             }
             if (st.name == std::string("ras")) {
                 ref[size_t(kind)] = im;
-            } else if (kind < 2) {
+            } else {
+                ASSERT_EQ(im.height, ref[size_t(kind)].height) << st.name << " " << kinds[kind];
                 to::expect_same_picture(im, ref[size_t(kind)],
                                         std::string(st.name) + " " + kinds[kind], true);
-            } else {
-                // The boxes grow in index order, so their outlines may differ between storages;
-                // the slice under them may not: every pixel grey (no outline, no tint) in both
-                // pictures is the same grey.
-                const lacuna::Image& want = ref[2];
-                ASSERT_EQ(im.width, want.width);
-                ASSERT_EQ(im.height, want.height);
-                size_t grey = 0, same = 0;
-                for (size_t p = 0; p < im.rgba.size(); p += 4) {
-                    auto is_grey = [p](const lacuna::Image& i) {
-                        return i.rgba[p] == i.rgba[p + 1] && i.rgba[p + 1] == i.rgba[p + 2];
-                    };
-                    if (!is_grey(im) || !is_grey(want)) continue;
-                    ++grey;
-                    same += im.rgba[p] == want.rgba[p];
-                }
-                EXPECT_EQ(same, grey) << st.name;
-                EXPECT_GT(grey, im.rgba.size() / 4 / 3)
-                    << st.name << ": a third of the slice is bare";
             }
+        }
+    }
+}
+
+// The boxes `partition` lists and draws are one set in the anatomy (issue 14, item 6): built on
+// the voxels in RAS order, the phantom stored RAS, LPS, sagittal PIR and permuted with flips
+// (IRP: i from superior, j toward the right, k from anterior) gives the same boxes at the same
+// world positions, in the same front-to-back order, with the same types and empty flags: kd-tree
+// with the default and with a candidate-plane spacing that does not divide the axes (planes
+// counted from a node's low index end then fall elsewhere in the anatomy under a flip; the
+// default spacing here is 1 cell, for which the old build happened to agree), and growing boxes
+// (seeded in x-fastest index order). The growing-boxes figure is the same byte for byte; the
+// kd-tree overlay draws the same outlines over the file's own render, which on a mirrored
+// lattice is the same picture within the issue's criterion (1 of 255 on 99.9% of the pixels).
+// The JSON's voxel coordinates are the file's own: its affine maps them to the listed world box.
+TEST(OrientationCli, PartitionBoxesAreOneSetInWorldCoordinatesInEveryStorage) {
+    namespace to = lacuna::test::orientation;
+    const lacuna::Volume base = to::phantom();
+    const fs::path tf = temp_dir() / "phantom-boxes.json";
+    std::ofstream(tf) << lacuna::to_json(to::phantom_tf());
+    struct Storage {
+        const char* name;
+        std::array<int, 3> perm;
+        std::array<bool, 3> flip;
+    };
+    const Storage storages[] = {{"ras", {0, 1, 2}, {false, false, false}},
+                                {"lps", {0, 1, 2}, {true, true, false}},
+                                {"pir", {1, 2, 0}, {true, true, false}},
+                                {"irp", {2, 0, 1}, {true, false, true}}};
+    const char* methods[] = {"--method kdtree", "--method kdtree --delta 7 --view superior",
+                             "--method boxes --view posterior"};
+    // One listed box as the anatomy sees it: world box, size, type and flags.
+    auto world_list = [](const nlohmann::json& list) {
+        std::vector<std::string> out;
+        for (const auto& b : list) {
+            std::string e;
+            for (const char* end : {"lo", "hi"})
+                for (int a = 0; a < 3; ++a)
+                    e += std::to_string(b["world"][end][size_t(a)].get<double>()) + " ";
+            e += std::to_string(b["cells"].get<int64_t>());
+            for (const char* key : {"type", "empty", "non_empty_cells", "parent"})
+                if (b.contains(key)) e += " " + b[key].dump();
+            out.push_back(e);
+        }
+        return out;
+    };
+    for (size_t m = 0; m < std::size(methods); ++m) {
+        std::vector<std::string> want_boxes, want_grown;
+        lacuna::Image want_png;
+        for (const Storage& st : storages) {
+            SCOPED_TRACE(std::string(st.name) + " " + methods[m]);
+            const fs::path file = temp_dir() / (std::string("boxes-") + st.name + ".nrrd");
+            if (m == 0) lacuna::write_volume(file.string(), to::reorder(base, st.perm, st.flip));
+            const std::string tag = std::string(st.name) + "-" + std::to_string(m);
+            const fs::path json = temp_dir() / (tag + ".json"), png = temp_dir() / (tag + ".png");
+            const CliResult r =
+                run("partition " + file.string() + " --tf " + tf.string() + " " + methods[m] +
+                    " --size 64 --json " + json.string() + " --out " + png.string());
+            ASSERT_EQ(r.code, 0) << r.err;
+            const nlohmann::json j = nlohmann::json::parse(lacuna::test::slurp_file(json));
+            // The file's voxel coordinates, mapped by the file's own affine, are the world box.
+            const lacuna::Volume v = lacuna::read_volume(file.string());
+            const lacuna::Affine aff = lacuna::index_to_world(v);
+            int64_t cells = 0;
+            for (const auto& b : j["boxes"]) {
+                cells += b["cells"].get<int64_t>();
+                double lo[3] = {INFINITY, INFINITY, INFINITY},
+                       hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+                for (int c = 0; c < 8; ++c) {
+                    const lacuna::Vec3d w = aff.apply({b[c & 1 ? "hi" : "lo"][0].get<double>(),
+                                                       b[c & 2 ? "hi" : "lo"][1].get<double>(),
+                                                       b[c & 4 ? "hi" : "lo"][2].get<double>()});
+                    for (int a = 0; a < 3; ++a)
+                        lo[a] = std::min(lo[a], w[a]), hi[a] = std::max(hi[a], w[a]);
+                }
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_NEAR(b["world"]["lo"][size_t(a)].get<double>(), lo[a], 1e-5);
+                    EXPECT_NEAR(b["world"]["hi"][size_t(a)].get<double>(), hi[a], 1e-5);
+                }
+            }
+            if (m == 2) EXPECT_EQ(cells, 40 * 48 * 36) << "the leaves tile the grid";
+            const std::vector<std::string> got_boxes = world_list(j["boxes"]),
+                                           got_grown = m == 2 ? world_list(j["grown_boxes"])
+                                                              : std::vector<std::string>{};
+            EXPECT_GT(got_boxes.size(), 3u);
+            const lacuna::Image im = lacuna::read_png(png.string());
+            if (st.name == std::string("ras")) {
+                want_boxes = got_boxes, want_grown = got_grown, want_png = im;
+                continue;
+            }
+            EXPECT_EQ(got_boxes, want_boxes) << "boxes, front to back";
+            EXPECT_EQ(got_grown, want_grown) << "grown boxes, in growth order";
+            ASSERT_EQ(im.height, want_png.height);
+            to::expect_same_picture(im, want_png, tag, m == 2);
         }
     }
 }
