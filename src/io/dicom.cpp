@@ -119,6 +119,43 @@ struct SliceInfo {
     int bits_allocated = 0;     // (0028,0100) as stored, before GDCM's rescaling
 };
 
+// ImageOrientationPatient (0020,0037) as GDCM judges it: six numbers, two rows of unit length
+// within 1e-3 and perpendicular within 1e-3, after normalising them if they were not unit. Where
+// GDCM finds no such pair it puts 1\0\0\0\1\0 in its place without a word (ITK reads that), so
+// a zero, singular or non-finite orientation read as an axial LPS slice: an error here instead
+// (issue 14, bad input), naming the slice and the field. An absent or empty field is left to
+// GDCM (secondary captures carry none).
+void check_orientation(const std::string& text, const std::string& file, const std::string& dir) {
+    std::string t = text;
+    while (!t.empty() && (t.back() == ' ' || t.back() == '\0')) t.pop_back();
+    if (t.find_first_not_of(' ') == std::string::npos) return;
+    std::vector<double> v;
+    std::stringstream parts(t);
+    bool numbers = true;
+    for (std::string p; std::getline(parts, p, '\\');) {
+        p = trim(p);
+        char* end = nullptr;
+        const double x = std::strtod(p.c_str(), &end);
+        numbers = numbers && !p.empty() && end && *end == '\0' && std::isfinite(x);
+        v.push_back(x);
+    }
+    const std::string shown = "ImageOrientationPatient is '" + one_line(t, 80) + "'";
+    if (!numbers || v.size() != 6)
+        throw Error(dir, file_name(file),
+                    shown + ": expected six finite direction cosines (a row and a column)");
+    const double n1 = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]),
+                 n2 = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
+    if (!(n1 > 0) || !(n2 > 0))
+        throw Error(dir, file_name(file),
+                    shown + ": a zero " + (n1 > 0 ? "column" : "row") +
+                        " direction (a zero or singular orientation)");
+    const double cosine = (v[0] * v[3] + v[1] * v[4] + v[2] * v[5]) / (n1 * n2);
+    if (!(std::fabs(cosine) < 1e-3))
+        throw Error(dir, file_name(file),
+                    shown + ": the row and column directions are not perpendicular (cos " +
+                        std::to_string(cosine) + "): a singular or sheared orientation");
+}
+
 // Reads one file's header into `io` (which is then ready for Read). Runs in the child.
 SliceInfo read_slice_info(itk::GDCMImageIO& io, const std::string& file, const std::string& dir) {
     SliceInfo s;
@@ -144,6 +181,8 @@ SliceInfo read_slice_info(itk::GDCMImageIO& io, const std::string& file, const s
         for (unsigned r = 0; r < 3 && r < col.size(); ++r) s.direction[r * 3 + a] = col[r];
     }
     std::string text;
+    if (itk::ExposeMetaData<std::string>(io.GetMetaDataDictionary(), "0020|0037", text))
+        check_orientation(text, file, dir);
     s.has_position =
         itk::ExposeMetaData<std::string>(io.GetMetaDataDictionary(), "0020|0032", text);
     if (itk::ExposeMetaData<std::string>(io.GetMetaDataDictionary(), "0028|0100", text))

@@ -126,6 +126,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer())) {
         quiet.reset();
         nrrd_files = check_nrrd_data_files(path, opts.allow_external_data);
+        check_nrrd_geometry(path);
         quiet.emplace();
     }
     try {
@@ -164,6 +165,10 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     Volume v(dims, stored_type(disk), path);
     copy_geometry(*io, v);
     v.geometry_source = geometry_source(path);
+    if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer()) && apply_nrrd_las_space(path, v))
+        v.geometry_source =
+            "NRRD space directions and space origin (left-anterior-superior space, converted to "
+            "LPS by lacuna)";
     if (meta_orientation) apply_anatomical_orientation(*meta_orientation, v, path);
     if (meta) {
         quiet.reset();

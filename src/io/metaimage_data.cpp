@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -87,6 +88,25 @@ class Inflater {
     bool m_done = false;
 };
 
+// The header fields that hold the index-to-world map (MetaIO's names and synonyms).
+bool geometry_key(const std::string& key) {
+    for (const char* k : {"TransformMatrix", "Rotation", "Orientation", "Offset", "Position",
+                          "Origin", "CenterOfRotation", "ElementSpacing", "ElementSize"})
+        if (key == k) return true;
+    return false;
+}
+
+std::vector<std::string> split_words(const std::string& s) {
+    std::vector<std::string> out;
+    size_t at = 0;
+    while ((at = s.find_first_not_of(" \t", at)) != std::string::npos) {
+        const size_t end = std::min(s.find_first_of(" \t", at), s.size());
+        out.push_back(s.substr(at, end - at));
+        at = end;
+    }
+    return out;
+}
+
 }  // namespace
 
 MetaHeaderOrientation check_metaimage_header(const std::string& path) {
@@ -131,6 +151,17 @@ MetaHeaderOrientation check_metaimage_header(const std::string& path) {
         if (to_lower(key) == "elementdatafile") return orientation;
         if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
             orientation.has_matrix = true;
+        // A geometry number that is not finite ("nan", "inf", 1e999) made MetaIO stop reading
+        // the header and blame a later field ("DimSize required and not defined"): name the
+        // field it is in (issue 14, bad input). Tokens strtod cannot read are MetaIO's to judge.
+        if (geometry_key(key))
+            for (const std::string& t : split_words(value)) {
+                char* end = nullptr;
+                const double x = std::strtod(t.c_str(), &end);
+                if (end && *end == '\0' && !std::isfinite(x))
+                    throw Error(path, key,
+                                "expected finite numbers, got '" + one_line(value, 80) + "'");
+            }
         if (key == "AnatomicalOrientation") orientation.anatomical_orientation = value;
         if (to_lower(key) != "ndims") continue;
         if (value != "3" && value != "4")

@@ -22,8 +22,10 @@ struct MetaDataLayout {
 // Throws Error(path, "header", ...) unless NDims is 3 or 4. Also guards MetaIO's fixed 255-byte
 // field buffers (a 256-character key or value aborted the process through glibc's fortify
 // check, found by fuzz_metaimage): every key and value up to ElementDataFile is at most 254
-// characters, and ElementDataFile must come within the first MiB. Call before ITK reads the
-// header. Returns what the header says about orientation (below).
+// characters, and ElementDataFile must come within the first MiB. A geometry field
+// (TransformMatrix, Offset, ElementSpacing and their synonyms) holding a number that is not
+// finite is Error(path, <field>, ...): MetaIO stops at it and blames a later field. Call before
+// ITK reads the header. Returns what the header says about orientation (below).
 struct MetaHeaderOrientation {
     bool has_matrix = false;             // TransformMatrix (or its synonyms Rotation, Orientation)
     std::string anatomical_orientation;  // the raw AnatomicalOrientation value ("" when absent)

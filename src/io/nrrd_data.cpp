@@ -1,5 +1,7 @@
 #include "io/nrrd_data.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -76,7 +78,103 @@ Error truncated(const std::string& header, uint64_t need, uint64_t have, const s
                      ", the data file has " + std::to_string(have));
 }
 
+// The "(a,b,c)" vectors of a space directions / space origin value ("none" entries as empty
+// vectors); false when the value is not a list of such vectors.
+bool nrrd_vectors(const std::string& value, std::vector<std::vector<double>>& out,
+                  bool& all_finite) {
+    all_finite = true;
+    size_t at = 0;
+    while ((at = value.find_first_not_of(" \t", at)) != std::string::npos) {
+        if (value.compare(at, 4, "none") == 0) {
+            out.emplace_back();
+            at += 4;
+            continue;
+        }
+        if (value[at] != '(') return false;
+        const size_t close = value.find(')', at);
+        if (close == std::string::npos) return false;
+        std::vector<double> v;
+        std::stringstream parts(value.substr(at + 1, close - at - 1));
+        for (std::string t; std::getline(parts, t, ',');) {
+            t = trim(t);
+            char* end = nullptr;
+            const double x = std::strtod(t.c_str(), &end);
+            if (t.empty() || !end || *end != '\0') return false;
+            all_finite = all_finite && std::isfinite(x);
+            v.push_back(x);
+        }
+        out.push_back(std::move(v));
+        at = close + 1;
+    }
+    return true;
+}
+
 }  // namespace
+
+void check_nrrd_geometry(const std::string& header) {
+    std::ifstream in(header, std::ios::binary);
+    std::string line;
+    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) break;
+        const size_t colon = line.find(':');
+        if (line[0] == '#' || colon == std::string::npos) continue;
+        const std::string key = trim(line.substr(0, colon));
+        if (key != "space directions" && key != "space origin") continue;
+        const std::string value = trim(line.substr(colon + 1));
+        std::vector<std::vector<double>> vectors;
+        bool finite = true;
+        if (!nrrd_vectors(value, vectors, finite)) continue;  // NrrdIO's to judge
+        if (!finite)
+            throw Error(header, key,
+                        "expected finite coordinates, got '" + one_line(value, 120) + "'");
+        if (key != "space directions") continue;
+        for (size_t a = 0; a < vectors.size(); ++a) {
+            const std::vector<double>& v = vectors[a];
+            if (!v.empty() && std::all_of(v.begin(), v.end(), [](double x) { return x == 0; }))
+                throw Error(header, key,
+                            "axis " + std::to_string(a) +
+                                " is the zero vector (a zero or singular affine): '" +
+                                one_line(value, 120) + "'");
+        }
+    }
+}
+
+bool apply_nrrd_las_space(const std::string& header, Volume& v) {
+    std::ifstream in(header, std::ios::binary);
+    std::string line, space;
+    std::vector<std::vector<double>> dirs, origin;
+    bool finite = true;
+    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) break;
+        const size_t colon = line.find(':');
+        if (line[0] == '#' || colon == std::string::npos) continue;
+        const std::string key = trim(line.substr(0, colon));
+        const std::string value = trim(line.substr(colon + 1));
+        if (key == "space") space = to_lower(value);
+        if (key == "space directions" && !nrrd_vectors(value, dirs, finite)) return false;
+        if (key == "space origin" && !nrrd_vectors(value, origin, finite)) return false;
+    }
+    if (space != "left-anterior-superior" && space != "las" &&
+        space != "left-anterior-superior-time" && space != "last")
+        return false;
+    std::vector<std::vector<double>> domain;
+    for (const auto& d : dirs)
+        if (!d.empty()) domain.push_back(d);
+    if (!finite || domain.size() != 3) return false;
+    for (int a = 0; a < 3; ++a) {
+        const std::vector<double>& d = domain[size_t(a)];
+        if (d.size() < 3) return false;
+        const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(len > 0)) return false;  // check_nrrd_geometry refused it already
+        const double lps[3] = {d[0], -d[1], d[2]};
+        for (int r = 0; r < 3; ++r) v.direction[r * 3 + a] = lps[r] / len + 0.0;
+    }
+    if (origin.size() == 1 && origin[0].size() >= 3)
+        v.origin = {origin[0][0], -origin[0][1] + 0.0, origin[0][2]};
+    return true;
+}
 
 std::optional<MetaDataLayout> nrrd_layout(const std::string& header,
                                           const std::vector<std::string>& data_files,

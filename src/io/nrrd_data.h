@@ -20,6 +20,22 @@
 
 namespace lacuna::io {
 
+// Checks the geometry fields of a NRRD header before NrrdIO reads it (issue 14, bad input):
+// Error(header, "space directions", ...) for a coefficient that is not finite or an axis that is
+// the zero vector (a zero or singular affine), Error(header, "space origin", ...) for a
+// coordinate that is not finite. NrrdIO would refuse the first with "existance of all space
+// vector coefficients must be consistent" and read the second as spacing 0; `none` axes and
+// anything else are left to NrrdIO.
+void check_nrrd_geometry(const std::string& header);
+
+// NRRD's left-anterior-superior space (LAS, and its -time variant) read as ITK 5.2's
+// NrrdImageIO reads it is wrong: it negates the x coordinates of the space directions and
+// origin (as for RAS) where LAS to LPS negates y, so such a file came out mirrored left-right
+// and front-back. For a LAS header with three domain axes this sets v's LPS direction and
+// origin from the header itself (x kept, y negated; an ITK that reads LAS right gives the same
+// numbers) and returns true; otherwise leaves v alone and returns false.
+bool apply_nrrd_las_space(const std::string& header, Volume& v);
+
 // The layout of a NRRD file's voxels when our reader can take them (raw or gzip, attached or
 // one data file), nullopt otherwise. `data_bytes` is the voxel bytes the header claims; `swap`
 // whether they are in the other byte order. Throws Error(header, "voxel data", "truncated:

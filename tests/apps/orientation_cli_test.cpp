@@ -106,6 +106,130 @@ TEST(OrientationCli, BadAffinesAreOneLineNamingTheFileAndFieldAndWriteNothing) {
     }
 }
 
+// The other formats' bad geometry (issue 14, bad input), each found by lacuna before the
+// library read it the way it does (docs/formats.md, "Only rigid grids"): a NRRD whose space
+// directions hold a zero axis or a NaN, or whose origin is infinite; a MetaImage whose
+// TransformMatrix, Offset or ElementSpacing holds a number that is not finite (MetaIO stopped
+// there and blamed DimSize); a DICOM series whose ImageOrientationPatient is zero, singular or
+// NaN (GDCM put 1\0\0\0\1\0 in its place and the series rendered as axial LPS, exit 0). Each is
+// one line naming the file and the field, exit 2, nothing written.
+TEST(OrientationCli, BadGeometryInNrrdMetaImageAndDicomIsOneLineNamingTheField) {
+    const std::string voxels(64, '\x20');
+    auto nrrd = [&](const std::string& name, const std::string& dirs, const std::string& origin) {
+        const fs::path p = temp_dir() / name;
+        std::ofstream(p, std::ios::binary)
+            << "NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\n"
+            << "sizes: 4 4 4\nspace directions: " << dirs
+            << "\nkinds: domain domain domain\nendian: little\nencoding: raw\nspace origin: "
+            << origin << "\n\n"
+            << voxels;
+        return p;
+    };
+    auto mha = [&](const std::string& name, const std::string& matrix, const std::string& offset,
+                   const std::string& spacing) {
+        const fs::path p = temp_dir() / name;
+        std::ofstream(p, std::ios::binary)
+            << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+            << "TransformMatrix = " << matrix << "\nOffset = " << offset
+            << "\nElementSpacing = " << spacing
+            << "\nDimSize = 4 4 4\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n"
+            << voxels;
+        return p;
+    };
+    // A DICOM series written by lacuna, every slice's ImageOrientationPatient replaced by `iop`
+    // (padded to the written value's length, so the files stay well formed).
+    auto dicom = [&](const std::string& name, const std::string& iop) {
+        const fs::path dir = temp_dir() / name;
+        fs::remove_all(dir);
+        const CliResult g =
+            run("generate sphere --dims 8x8x4 --type int16 --out " + dir.string() + "/");
+        EXPECT_EQ(g.code, 0) << g.err;
+        int patched = 0;
+        for (const auto& e : fs::directory_iterator(dir)) {
+            std::string f = lacuna::test::slurp_file(e.path());
+            const size_t tag = f.find(std::string("\x20\x00\x37\x00", 4), 132);
+            if (tag == std::string::npos) continue;
+            // Implicit VR little endian (lacuna's writer): a 4-byte length after the tag.
+            const size_t len = size_t(uint8_t(f[tag + 4])) | size_t(uint8_t(f[tag + 5])) << 8;
+            EXPECT_GE(len, iop.size()) << e.path();
+            std::string value = iop;
+            value.resize(len, ' ');
+            f.replace(tag + 8, len, value);
+            std::ofstream(e.path(), std::ios::binary) << f;
+            ++patched;
+        }
+        EXPECT_EQ(patched, 4) << name;
+        return dir;
+    };
+    const struct {
+        fs::path file;
+        std::string field;
+    } cases[] = {
+        {nrrd("zero-axis.nrrd", "(0,0,0) (0,1,0) (0,0,1)", "(0,0,0)"), "space directions"},
+        {nrrd("nan-axis.nrrd", "(1,0,0) (0,nan,0) (0,0,1)", "(0,0,0)"), "space directions"},
+        {nrrd("inf-origin.nrrd", "(1,0,0) (0,1,0) (0,0,1)", "(0,inf,0)"), "space origin"},
+        {nrrd("singular.nrrd", "(1,0,0) (2,0,0) (0,0,1)", "(0,0,0)"), "direction"},
+        {mha("nan-matrix.mha", "1 0 0 0 nan 0 0 0 1", "0 0 0", "1 1 1"), "TransformMatrix"},
+        {mha("inf-offset.mha", "1 0 0 0 1 0 0 0 1", "0 inf 0", "1 1 1"), "Offset"},
+        {mha("nan-spacing.mha", "1 0 0 0 1 0 0 0 1", "0 0 0", "1 nan 1"), "ElementSpacing"},
+        {mha("zero-matrix.mha", "0 0 0 0 0 0 0 0 0", "0 0 0", "1 1 1"), "direction"},
+        {mha("singular.mha", "1 0 0 1 0 0 0 0 1", "0 0 0", "1 1 1"), "direction"},
+        {dicom("dicom-zero-iop", "0\\0\\0\\0\\0\\0"),
+         "ImageOrientationPatient is '0\\0\\0\\0\\0\\0'"},
+        {dicom("dicom-singular-iop", "1\\0\\0\\1\\0\\0"), "not perpendicular (cos 1"},
+        {dicom("dicom-nan-iop", "nan\\0\\0\\0\\1\\0"), "expected six finite direction cosines"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.file.string());
+        const fs::path png = temp_dir() / (c.file.filename().string() + ".png");
+        const CliResult r =
+            run("render " + c.file.string() + " --tf mr-default --size 16 --out " + png.string());
+        expect_one_line_error(r, c.file.string() + ": ");
+        EXPECT_NE(r.err.find(c.field), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(png));
+        expect_one_line_error(run("info " + c.file.string()), c.field);
+    }
+    // Unit rows are not required (GDCM normalises them, and so do the readers that use it).
+    const fs::path ok = dicom("dicom-unnormalised-iop", "2\\0\\0\\0\\1\\0");
+    const CliResult r = run("info " + ok.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("orientation: LPS"), std::string::npos) << r.out;
+}
+
+// NRRD's three anatomical spaces hold one anatomy the same way: i toward the right in 2 mm
+// steps, j anterior, k superior in 3 mm, voxel 0 at RAS (10, 20, 30), written in RAS, LAS and
+// LPS coordinates (and LAS by its short name). ITK 5.2 reads LAS by negating x instead of y, which
+// mirrored such a file left-right and front-back (RPS instead of RAS); lacuna reads the header's
+// LAS numbers itself.
+TEST(OrientationCli, NrrdRasLasAndLpsSpacesGiveOneWorld) {
+    const std::string voxels(6 * 5 * 4, '\x40');
+    const struct {
+        const char* name;
+        const char* space;
+        const char* dirs;
+        const char* origin;
+    } files[] = {
+        {"ras.nrrd", "right-anterior-superior", "(2,0,0) (0,1,0) (0,0,3)", "(10,20,30)"},
+        {"las.nrrd", "left-anterior-superior", "(-2,0,0) (0,1,0) (0,0,3)", "(-10,20,30)"},
+        {"las-short.nrrd", "LAS", "(-2,0,0) (0,1,0) (0,0,3)", "(-10,20,30)"},
+        {"lps.nrrd", "left-posterior-superior", "(-2,0,0) (0,-1,0) (0,0,3)", "(-10,-20,30)"},
+    };
+    for (const auto& f : files) {
+        const fs::path p = temp_dir() / (std::string("space-") + f.name);
+        std::ofstream(p, std::ios::binary)
+            << "NRRD0004\ntype: uint8\ndimension: 3\nspace: " << f.space
+            << "\nsizes: 6 5 4\nspace directions: " << f.dirs
+            << "\nkinds: domain domain domain\nendian: little\nencoding: raw\nspace origin: "
+            << f.origin << "\n\n"
+            << voxels;
+        const CliResult r = run("info " + p.string());
+        ASSERT_EQ(r.code, 0) << f.name << ": " << r.err;
+        EXPECT_NE(r.out.find("orientation: RAS"), std::string::npos) << f.name << ": " << r.out;
+        EXPECT_NE(r.out.find("[2 0 0 10] [0 1 0 20] [0 0 3 30]"), std::string::npos)
+            << f.name << ": " << r.out;
+    }
+}
+
 // A NIfTI whose geometry float cannot resolve (pixdim 1e-40 or 1e20, qoffset 1e9 with 1 mm
 // voxels, an sform translation of 1e16) used to render an empty picture and exit 0.
 TEST(OrientationCli, GeometryFloatCannotResolveIsAnErrorNotAnEmptyPicture) {
