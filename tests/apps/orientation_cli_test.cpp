@@ -64,6 +64,16 @@ TEST(OrientationCli, InfoPrintsTheAffineTheCodeTheTransformAndTheRasBounds) {
     EXPECT_NE(r.out.find("NIfTI sform (sform_code 1, scanner)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("[-2 0 0 10] [0 -1 0 20] [0 0 3 -5]"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("x 0 .. 10, y 14 .. 20, z -5 .. 16 mm"), std::string::npos) << r.out;
+    // A qform only (quaternion b = 1: a half turn about x, so j posterior and k inferior; qfac 1).
+    lacuna::test::NiftiSpec qf;
+    qf.qform_code = 2;
+    qf.quatern = {1, 0, 0};
+    qf.qoffset = {1, 2, 3};
+    const CliResult q = run("info " + nifti("qform.nii", qf).string());
+    ASSERT_EQ(q.code, 0) << q.err;
+    EXPECT_NE(q.out.find("orientation: RPI"), std::string::npos) << q.out;
+    EXPECT_NE(q.out.find("NIfTI qform (qform_code 2, aligned)"), std::string::npos) << q.out;
+    EXPECT_NE(q.out.find("[1 0 0 1] [0 -1 0 2] [0 0 -1 3]"), std::string::npos) << q.out;
     // No transform at all: pixdim only, world = index x spacing.
     lacuna::test::NiftiSpec none;
     none.pixdim = {1, 2, 3};
@@ -317,6 +327,14 @@ TEST(OrientationCli, ViewsAreNamedAnglesAndLpsAndRasFilesOfOneAnatomyGiveOnePng)
         0);
     ASSERT_EQ(run("render " + a.string() +
                   " --tf mr-default --size 24 --azimuth 90 --elevation 0 --out " + v2.string())
+                  .code,
+              0);
+    EXPECT_EQ(lacuna::test::slurp_file(v1), lacuna::test::slurp_file(v2));
+    // Without --view or angles: azimuth 30, elevation 15 (the front-left view, upright).
+    ASSERT_EQ(run("render " + a.string() + " --tf mr-default --size 24 --out " + v1.string()).code,
+              0);
+    ASSERT_EQ(run("render " + a.string() +
+                  " --tf mr-default --size 24 --azimuth 30 --elevation 15 --out " + v2.string())
                   .code,
               0);
     EXPECT_EQ(lacuna::test::slurp_file(v1), lacuna::test::slurp_file(v2));

@@ -18,9 +18,11 @@
 #include "core/simd_lanes.h"
 #include "lacuna/accel.h"
 #include "lacuna/camera.h"
+#include "lacuna/frame_spec.h"
 #include "lacuna/io.h"
 #include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
+#include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
 #include "orientation_test_util.h"
 
@@ -230,7 +232,9 @@ TEST(Orientation, EveryVoxelOrderAndFormatOfThePhantomRendersTheSamePicture) {
     }
 }
 
-// The real head: ch2 as shipped (RAS), and re-stored mirrored, permuted and as DICOM.
+// The real head: ch2 as shipped (RAS), and re-stored in six other voxel orders and conventions
+// (LPS NRRD, sagittal PIR MetaImage, permuted SRA detached NRRD, LPI NIfTI-2 qform only, coronal
+// LIA NIfTI-1 sform only, an axial LPS DICOM series).
 TEST(Orientation, TheCh2HeadRendersTheSameInEveryStorage) {
     const std::string ch2 = "/usr/share/mricron/templates/ch2.nii.gz";
     if (!std::filesystem::exists(ch2)) GTEST_SKIP() << ch2 << " (Debian mricron-data) is missing";
@@ -242,7 +246,7 @@ TEST(Orientation, TheCh2HeadRendersTheSameInEveryStorage) {
     const RenderResult want = render(base, cam, lut);
     const test::ScratchDir dir;
     for (const Variant& var :
-         {kVariants[1], kVariants[2], kVariants[4], kVariants[5], kVariants[6]}) {
+         {kVariants[1], kVariants[2], kVariants[3], kVariants[4], kVariants[5], kVariants[6]}) {
         const Volume v = write_and_read(reorder(base, var.perm, var.flip), var, dir);
         SCOPED_TRACE(var.name);
         EXPECT_EQ(orientation_code(v), var.code);
@@ -318,6 +322,17 @@ TEST(Orientation, NamedViewsPutTheAnatomyWhereRadiologistsExpectIt) {
     EXPECT_LT(y, 43);
     ASSERT_TRUE(centroid(top, 0, x, y));
     EXPECT_GT(x, 53);
+    // The default view (azimuth 30, elevation 15: render's and the viewer's) is from the
+    // front-left and upright: the face (anterior marker) is left of centre, as in the left view,
+    // the top marker above the centre, and the right marker, seen past the face, left too.
+    const Image deflt =
+        render(v, orbit(b, 30, 15, Projection::Orthographic, 96), lut, nullptr, mip()).image;
+    ASSERT_TRUE(centroid(deflt, 1, x, y));
+    EXPECT_LT(x, 43);
+    ASSERT_TRUE(centroid(deflt, 2, x, y));
+    EXPECT_LT(y, 43);
+    ASSERT_TRUE(centroid(deflt, 0, x, y));
+    EXPECT_LT(x, 47.5);
 }
 
 // The phantom with its sform turned 30 degrees about the superior axis (about its centre):
@@ -436,6 +451,78 @@ TEST(Orientation, EveryStructureAndKernelPathIsExactOnObliqueData) {
         }
     }
     EXPECT_GT(compared, 40);
+}
+
+// "Every structure stays exact on oblique data", for every renderer and not only the marcher:
+// through the session, each structure on each renderer the capabilities table grants it (the
+// slicer's kd-tree and growing boxes, the segment renderer's label octree and its mask mode over
+// the intensity structures, the marcher's) gives that renderer's image without skipping byte for
+// byte, on the phantom turned 30 degrees and on a copy rotated about all three axes and mirrored,
+// with a label map in the same (oblique) frame.
+TEST(Orientation, EveryStructureOnEveryRendererIsExactOnObliqueData) {
+    Volume mirrored = phantom();
+    {
+        const double a = 0.7, b = 0.4;  // about x, then about z; then j reversed
+        const Mat3 rx{{{1, 0, 0}, {0, std::cos(a), -std::sin(a)}, {0, std::sin(a), std::cos(a)}}};
+        const Mat3 rz{{{std::cos(b), -std::sin(b), 0}, {std::sin(b), std::cos(b), 0}, {0, 0, 1}}};
+        Mat3 r{};
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                for (int k = 0; k < 3; ++k) r[i][j] += rz[i][k] * rx[k][j];
+        for (int row = 0; row < 3; ++row) r[row][1] = -r[row][1];
+        set_ras_direction(mirrored, r);
+        set_ras_origin(mirrored, {12, -40, 7});
+    }
+    int compared = 0;
+    for (const Volume& v : {rotated(phantom(), 30), mirrored}) {
+        ASSERT_NO_THROW(check_geometry(v, "oblique"));
+        // Labels: the body 1, each marker its own label, in the volume's own frame.
+        Volume labels(v.dims(), VoxelType::UInt8);
+        labels.spacing = v.spacing;
+        labels.origin = v.origin;
+        std::copy(std::begin(v.direction), std::end(v.direction), labels.direction);
+        for (int k = 0; k < v.dims().z; ++k)
+            for (int j = 0; j < v.dims().y; ++j)
+                for (int i = 0; i < v.dims().x; ++i) {
+                    const float x = v.value(i, j, k);
+                    labels.set_value(i, j, k,
+                                     x > 200   ? 4.f
+                                     : x > 140 ? 3.f
+                                     : x > 90  ? 2.f
+                                     : x > 20  ? 1.f
+                                               : 0.f);
+                }
+        labels.compute_range();
+        Session session(v, 1);
+        session.set_labels(std::move(labels));
+        session.set_transfer_function(phantom_tf());
+        for (const RendererCapabilities& cap : capabilities()) {
+            FrameSpec none;
+            none.renderer = cap.renderer;
+            none.structure = structure::None{};
+            none.width = 56;
+            none.height = 48;
+            none.camera.orbit.azimuth_deg = 35.f;
+            none.camera.orbit.elevation_deg = 20.f;
+            const FrameResult reference = session.render(none);
+            size_t lit = 0;
+            for (size_t p = 0; p < reference.image.rgba.size(); p += 4)
+                lit += reference.image.rgba[p] + reference.image.rgba[p + 1] +
+                           reference.image.rgba[p + 2] >
+                       0;
+            EXPECT_GT(lit, 80u) << to_string(cap.renderer) << ": the markers are in view";
+            for (const Structure& st : all_structures()) {
+                if (!cap.takes(st)) continue;
+                FrameSpec f = none;
+                f.structure = st;
+                const FrameResult r = session.render(f);
+                EXPECT_TRUE(r.image.rgba == reference.image.rgba)
+                    << to_string(cap.renderer) << " " << structure_name(st);
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 20);
 }
 
 // Features in world coordinates on an oblique volume: a clip plane, a crop box (which becomes
