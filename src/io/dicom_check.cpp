@@ -56,32 +56,77 @@ struct Encoding {
     bool explicit_vr = true, big = false;
 };
 
-// GDCM's guess for a data set that starts at `h` (8 bytes, `got` of them read) without a file
-// meta group: FileMetaInformation::ReadCompat of GDCM 3.0.21 (Debian 12's), branch by branch,
-// checked against its source. False when GDCM
-// gives up on the file ("Cannot find DICOM type") or reads no value of it (implicit big
-// endian, which GDCM refuses).
-bool guess_encoding(const uint8_t* h, size_t got, Encoding& enc) {
-    if (got < 4) return false;  // "Cannot read very first tag"
-    const uint16_t g = u16(h, false), e = u16(h + 2, false);
-    const bool vr = got >= 6 && known_vr(h + 4);
-    if (g == 0x0008) {
-        enc = {vr, false};
-    } else if (g == 0x0800) {  // ACR-NEMA big endian
-        if (!vr) return false;
-        enc = {true, true};
-    } else if (e == 0x0010) {  // a private creator first: little endian
-        enc = {vr, false};
-    } else if (vr) {
-        enc = {true, g > 0xFF || e > 0xFF};
-    } else if (g == 0 && e == 0 && got >= 8 && u32(h + 4, false) == 4) {
-        // A (0000,0000) element of 4 bytes (a crafted file): GDCM guesses again from the next
-        // element and asserts that the answer is implicit little endian; walked as that.
-        enc = {false, false};
-    } else {
-        return false;
+// How many (0000,0000) elements may open a data set before the walk refuses it (see below).
+constexpr int kMaxNullElements = 16;
+
+// GDCM's guess for a data set that starts at byte `base` without a file meta group:
+// FileMetaInformation::ReadCompat of GDCM 3.0.21 (Debian 12's), branch by branch, checked
+// against its source. False when GDCM gives up on the file ("Cannot find DICOM type", "Cannot
+// read very first tag") or reads no value of it (implicit big endian, which GDCM refuses).
+//
+// One branch calls ReadCompat again: a first element (0000,0000) in implicit VR with a length
+// of 4 (GDCM's comment: "something like IM-0001-0066.CommandTag00.dcm was crafted"). GDCM reads
+// its value, guesses from the element after it, then `assert(DataSetTS ==
+// ImplicitVRLittleEndian)`, seeks back to the (0000,0000) and reads the data set from there.
+// Debian's GDCM keeps its asserts (finding 2 of "Readers" in docs/reliability.md was one), so
+// every other answer of the second guess aborts GDCM: a group 0002 meta group after it, any
+// explicit VR, group 0800 (big endian either way). The walk follows the same chain: an answer
+// other than implicit little endian is refused here with one line (before, it was walked as
+// implicit and left to abort GDCM in the reader's child, which the parent reports as GDCM
+// dying); a second guess that gives up means GDCM gives up on the file; and each further
+// (0000,0000) is one more recursive call, so a data set opening with more than
+// kMaxNullElements of them (a real file has at most one) is refused too, long before GDCM's
+// stack would run out (a few hundred bytes of frame per 12-byte element).
+bool guess_encoding(const ReadAt& read, uint64_t base, Encoding& enc, const std::string& name,
+                    const std::string& dir) {
+    uint8_t h[8];
+    for (int nulls = 0;; ++nulls) {
+        const uint64_t pos = base + uint64_t(nulls) * 12;
+        const size_t got = read(pos, h, 8);
+        if (got < 4) return false;  // "Cannot read very first tag"
+        const uint16_t g = u16(h, false), e = u16(h + 2, false);
+        const bool vr = got >= 6 && known_vr(h + 4);
+        const auto refuse = [&](const std::string& what) {
+            throw Error(dir, name,
+                        "starts with element (0000,0000) followed by " + what + " at byte " +
+                            std::to_string(pos) +
+                            " (GDCM asserts that such a data set is implicit VR little "
+                            "endian: a crafted file)");
+        };
+        // (A meta group at `base` itself is the walk's, before any guess.)
+        if (g == 0x0002 && nulls > 0) refuse("a file meta group element " + tag_text(g, e));
+        if (g == 0x0008) {
+            enc = {vr, false};
+        } else if (g == 0x0800) {  // ACR-NEMA big endian
+            if (nulls > 0) refuse("a big-endian element " + tag_text(g, e));
+            if (!vr) return false;
+            enc = {true, true};
+        } else if (e == 0x0010) {  // a private creator first: little endian
+            enc = {vr, false};
+        } else if (vr) {
+            enc = {true, g > 0xFF || e > 0xFF};
+        } else if (g == 0 && e == 0 && got >= 8 && u32(h + 4, false) == 4) {
+            // (0000,0000) of 4 bytes: its value, then GDCM guesses again from the next element.
+            // A value cut short leaves GDCM's stream failed (its next guess asserts on that):
+            // walked as implicit, the walk reports that element's length.
+            uint8_t value[4];
+            if (read(pos + 8, value, 4) != 4) {
+                enc = {false, false};
+                return true;
+            }
+            if (nulls + 1 > kMaxNullElements)
+                throw Error(dir, name,
+                            "starts with more than " + std::to_string(kMaxNullElements) +
+                                " elements (0000,0000) (GDCM reads each one recursively: a "
+                                "crafted file)");
+            continue;
+        } else {
+            return false;  // "Cannot find DICOM type. Giving up."
+        }
+        if (nulls > 0 && (enc.explicit_vr || enc.big))
+            refuse("an explicit-VR element " + tag_text(g, e));
+        return true;
     }
-    return true;
 }
 
 // At most this many top-level elements: a real slice has hundreds, a file of empty elements
@@ -106,7 +151,7 @@ DicomWalk walk(const ReadAt& read, uint64_t size, const std::string& name,
         in_meta = true;
     } else if (got >= 4 || !w.part10) {
         // A Part 10 file with no meta group, or no preamble: GDCM's guess (ReadCompat).
-        if (!guess_encoding(h, got, enc)) return w;
+        if (!guess_encoding(read, pos, enc, name, dir)) return w;
         in_meta = false;
     }
     w.dicom = true;
