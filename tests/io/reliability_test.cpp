@@ -223,6 +223,46 @@ TEST(IoBudget, CliTakesMaxMemoryAndNamesIt) {
     test::expect_one_line_error(bad, "--max-memory: size: expected a size like 12G");
 }
 
+// Issue 15's target: "A 142-byte file claiming 30000^3 fails", one line naming the file and the
+// field, exit 2, nothing written, the input untouched; in every format whose header states the
+// dims, through `info` and `render` (time and memory: docs/reliability.md, "Targets checked").
+TEST(IoBudget, CliRefusesA30000CubedClaimInOneLineAndWritesNothing) {
+    ScratchDir dir, out;
+    NiftiSpec spec;
+    spec.dims = {30000, 30000, 30000};
+    spec.datatype = 4;  // int16: 54 TB
+    const uint8_t vox[16] = {};
+    const std::vector<uint8_t> nii = test::nifti_bytes(spec, vox, sizeof vox);
+    const std::vector<uint8_t> gz = test::gzip(nii);
+    EXPECT_LE(gz.size(), 142u);
+    const std::string tail(16, '\0');
+    const std::vector<std::pair<std::string, std::string>> files{
+        {"claim.nii.gz", std::string(gz.begin(), gz.end())},
+        {"claim.nii", std::string(nii.begin(), nii.end())},
+        {"claim.nrrd", "NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 30000\n"
+                       "endian: little\nencoding: raw\n\n" + tail},
+        {"claim.mha", "ObjectType = Image\nNDims = 3\nDimSize = 30000 30000 30000\n"
+                      "ElementType = MET_SHORT\nElementDataFile = LOCAL\n" + tail},
+    };
+    for (const auto& [name, bytes] : files) {
+        SCOPED_TRACE(name);
+        const std::string path = dir.file(name);
+        test::write_text(path, bytes);
+        for (const std::string& cmd :
+             {"info " + path, "render " + path + " --tf mr-default --size 16 --out " +
+                                  out.file("frame.png")}) {
+            const auto r = test::run_cli(cmd, out.path());
+            test::expect_one_line_error(r, name + ": dims: 30000x30000x30000");
+            EXPECT_EQ(out.names(), (std::vector<std::string>{"stderr.txt", "stdout.txt"}))
+                << cmd;
+            EXPECT_EQ(dir.names(), std::vector<std::string>{name}) << cmd;
+            const std::vector<uint8_t> now = test::file_bytes(path);
+            EXPECT_EQ(std::string(now.begin(), now.end()), bytes) << cmd;
+        }
+        fs::remove(path);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Detached headers
 
@@ -646,6 +686,82 @@ TEST(IoDicomFolder, HugeLengthInAFileWithoutPreambleIsAnError) {
         fs::remove(s + "/junk");
     }
     EXPECT_EQ(read_volume(s).dims(), (Vec3i{8, 8, 3}));
+}
+
+// GDCM's guess has one recursive branch: a data set opening with (0000,0000) of length 4 (a
+// "crafted" file, GDCM's word) is guessed again from the next element, and GDCM then asserts
+// that the answer is implicit VR little endian (Debian's GDCM keeps its asserts). The walk
+// follows the chain (dicom_check.cpp, guess_encoding): any other answer is refused with one
+// line before GDCM runs (it used to abort GDCM in the reader's child), more than 16 of them
+// too (one recursive call each), an implicit answer is walked from byte 0, and a second guess
+// that fails leaves the file to be ignored, as GDCM ignores it.
+TEST(IoDicomFolder, ADataSetOpeningWithElement0000IsGuessedAsGdcmGuessesIt) {
+    ScratchDir dir;
+    const std::string s = write_series(dir, "s", 3);
+    const std::vector<uint8_t> null0{0, 0, 0, 0, 4, 0, 0, 0, 1, 2, 3, 4};  // (0000,0000) UL 4
+    const auto after_null = [&](std::vector<uint8_t> rest, int nulls = 1) {
+        std::vector<uint8_t> b;
+        for (int i = 0; i < nulls; ++i) b.insert(b.end(), null0.begin(), null0.end());
+        b.insert(b.end(), rest.begin(), rest.end());
+        return b;
+    };
+    struct Case {
+        const char* what;
+        std::vector<uint8_t> bytes;
+        const char* expect;
+    };
+    const std::vector<Case> refused{
+        {"then an explicit-VR element of group 0008",
+         after_null({0x08, 0, 0x16, 0, 'U', 'I', 2, 0, '1', 0}),
+         "starts with element (0000,0000) followed by an explicit-VR element (0008,0016) at "
+         "byte 12 (GDCM asserts"},
+        {"then an explicit private creator",
+         after_null({0x09, 0, 0x10, 0, 'L', 'O', 2, 0, 'A', 'B'}),
+         "followed by an explicit-VR element (0009,0010) at byte 12"},
+        {"then an explicit element of another group",
+         after_null({0x10, 0, 0x20, 0, 'L', 'O', 2, 0, 'A', 'B'}),
+         "followed by an explicit-VR element (0010,0020) at byte 12"},
+        {"then ACR-NEMA big endian (implicit)", after_null({0, 0x08, 0, 0x16, 0, 0, 0, 2, 'a', 'b'}),
+         "followed by a big-endian element (0800,1600) at byte 12"},
+        {"then a file meta group", after_null({2, 0, 1, 0, 'O', 'B', 0, 0, 2, 0, 0, 0, 0, 1}),
+         "followed by a file meta group element (0002,0001) at byte 12"},
+        {"the same after two of them", after_null({0x08, 0, 0x16, 0, 'U', 'I', 2, 0, '1', 0}, 2),
+         "followed by an explicit-VR element (0008,0016) at byte 24"},
+        {"17 of them", after_null({0x08, 0, 0x16, 0, 2, 0, 0, 0, '1', 0}, 17),
+         "starts with more than 16 elements (0000,0000)"},
+        {"then an implicit element whose length runs past the end: walked from byte 0",
+         after_null({0x08, 0, 0x16, 0, 0xff, 0xff, 0xff, 0x7f, 1, 2}),
+         "element (0008,0016) says 2147483647 bytes, 2 are left"},
+        {"its own value cut short", {0, 0, 0, 0, 4, 0, 0, 0, 1, 2},
+         "element (0000,0000) says 4 bytes, 2 are left"},
+    };
+    for (const Case& c : refused) {
+        for (const char* name : {"junk.dcm", "junk"}) {
+            test::write_bytes(s + "/" + name, c.bytes);
+            const std::string msg = read_error(s);
+            EXPECT_NE(msg.find(name + std::string(": ") + c.expect), std::string::npos)
+                << c.what << ", " << name << ": " << msg;
+            EXPECT_EQ(msg.find("died"), std::string::npos) << c.what << ": " << msg;
+            fs::remove(s + "/" + name);
+        }
+    }
+    // The second guess fails ("Cannot find DICOM type", "Cannot read very first tag"): GDCM
+    // does not take the file for DICOM, so under a name that does not say DICOM it is ignored.
+    for (const std::vector<uint8_t>& bytes :
+         {after_null({'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd'}), null0,
+          after_null({0x10, 0})}) {
+        test::write_bytes(s + "/junk", bytes);
+        EXPECT_EQ(read_volume(s).dims(), (Vec3i{8, 8, 3}));
+    }
+    // Sixteen of them and a whole implicit element: walked to the end, and no verdict of the
+    // walk stops the series (GDCM reads the file as a data set and places it in no series,
+    // which is the reader's error for a file named .dcm).
+    fs::remove(s + "/junk");
+    test::write_bytes(s + "/junk.dcm", after_null({0x08, 0, 0x16, 0, 2, 0, 0, 0, '1', 0}, 16));
+    const std::string msg = read_error(s);
+    EXPECT_NE(msg.find("junk.dcm: is a DICOM file that GDCM could not place in any series"),
+              std::string::npos)
+        << msg;
 }
 
 // Files GDCM does not take for DICOM (its guess from the first tag fails) are still ignored,
