@@ -16,6 +16,7 @@
 #include <limits>
 
 #include "apps/cli_run.h"
+#include "io/dicom_check.h"
 #include "io/io_test_util.h"
 #include "io/nifti_test_file.h"
 #include "lacuna/image.h"
@@ -722,7 +723,7 @@ TEST(IoDicomFolder, ADataSetOpeningWithElement0000IsGuessedAsGdcmGuessesIt) {
          after_null({0x10, 0, 0x20, 0, 'L', 'O', 2, 0, 'A', 'B'}),
          "followed by an explicit-VR element (0010,0020) at byte 12"},
         {"then ACR-NEMA big endian (implicit)", after_null({0, 0x08, 0, 0x16, 0, 0, 0, 2, 'a', 'b'}),
-         "followed by a big-endian element (0800,1600) at byte 12"},
+         "followed by a big-endian element (0008,0016) at byte 12"},
         {"then a file meta group", after_null({2, 0, 1, 0, 'O', 'B', 0, 0, 2, 0, 0, 0, 0, 1}),
          "followed by a file meta group element (0002,0001) at byte 12"},
         {"the same after two of them", after_null({0x08, 0, 0x16, 0, 'U', 'I', 2, 0, '1', 0}, 2),
@@ -753,15 +754,19 @@ TEST(IoDicomFolder, ADataSetOpeningWithElement0000IsGuessedAsGdcmGuessesIt) {
         test::write_bytes(s + "/junk", bytes);
         EXPECT_EQ(read_volume(s).dims(), (Vec3i{8, 8, 3}));
     }
-    // Sixteen of them and a whole implicit element: walked to the end, and no verdict of the
-    // walk stops the series (GDCM reads the file as a data set and places it in no series,
-    // which is the reader's error for a file named .dcm).
-    fs::remove(s + "/junk");
-    test::write_bytes(s + "/junk.dcm", after_null({0x08, 0, 0x16, 0, 2, 0, 0, 0, '1', 0}, 16));
-    const std::string msg = read_error(s);
-    EXPECT_NE(msg.find("junk.dcm: is a DICOM file that GDCM could not place in any series"),
-              std::string::npos)
-        << msg;
+    // The limit, on the walk alone: sixteen of them and a whole implicit element are walked to
+    // the end of the file; seventeen are refused.
+    for (int nulls : {1, 16, 17}) {
+        const std::vector<uint8_t> b = after_null({0x08, 0, 0x16, 0, 2, 0, 0, 0, '1', 0}, nulls);
+        if (nulls <= 16) {
+            const io::DicomWalk w = io::walk_dicom_bytes(b.data(), b.size(), "junk", s);
+            EXPECT_TRUE(w.dicom && w.checked) << nulls;
+        } else {
+            EXPECT_NE(test::error_of([&] { io::walk_dicom_bytes(b.data(), b.size(), "junk", s); })
+                          .find("junk: starts with more than 16 elements (0000,0000)"),
+                      std::string::npos);
+        }
+    }
 }
 
 // Files GDCM does not take for DICOM (its guess from the first tag fails) are still ignored,
