@@ -98,7 +98,8 @@ bool guess_encoding(const ReadAt& read, uint64_t base, Encoding& enc, const std:
         if (g == 0x0008) {
             enc = {vr, false};
         } else if (g == 0x0800) {  // ACR-NEMA big endian
-            if (nulls > 0) refuse("a big-endian element " + tag_text(u16(h, true), u16(h + 2, true)));
+            if (nulls > 0)
+                refuse("a big-endian element " + tag_text(u16(h, true), u16(h + 2, true)));
             if (!vr) return false;
             enc = {true, true};
         } else if (e == 0x0010) {  // a private creator first: little endian

@@ -31,10 +31,12 @@ nii = bytes(h) + b"\0" * 4 + b"\0" * 16
 open(f"{d}/claim.nii", "wb").write(nii)
 open(f"{d}/claim.nii.gz", "wb").write(gzip.compress(nii, 9, mtime=0))
 tail = b"\0" * 16
-open(f"{d}/claim.nrrd", "wb").write(b"NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 30000\n"
-                                    b"endian: little\nencoding: raw\n\n" + tail)
-open(f"{d}/claim.mha", "wb").write(b"ObjectType = Image\nNDims = 3\nDimSize = 30000 30000 30000\n"
-                                   b"ElementType = MET_SHORT\nElementDataFile = LOCAL\n" + tail)
+nrrd = (b"NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 30000\n"
+        b"endian: little\nencoding: raw\n\n")
+mha = (b"ObjectType = Image\nNDims = 3\nDimSize = 30000 30000 30000\n"
+       b"ElementType = MET_SHORT\nElementDataFile = LOCAL\n")
+open(f"{d}/claim.nrrd", "wb").write(nrrd + tail)
+open(f"{d}/claim.mha", "wb").write(mha + tail)
 EOF
 printf '%-20s %-6s %8s %6s %9s %4s %5s %7s %9s  %s\n' file cmd wall cpu_s maxrss_kB exit lines written unchanged stderr
 for f in claim.nii.gz claim.nii claim.nrrd claim.mha; do
@@ -42,7 +44,8 @@ for f in claim.nii.gz claim.nii claim.nrrd claim.mha; do
   sum=$(sha256sum "$in" | cut -d' ' -f1)
   for cmd in info render; do
     args=(info "$in")
-    [ "$cmd" = render ] && args=(render "$in" --tf mr-default --size 16 --out "$tmp/out/frame.png")
+    [ "$cmd" = render ] &&
+      args=(render "$in" --tf mr-default --size 16 --out "$tmp/out/frame.png")
     set +e
     /usr/bin/time -v -o "$tmp/time.txt" "$cli" "${args[@]}" >/dev/null 2>"$tmp/err.txt"
     code=$?
@@ -53,7 +56,7 @@ for f in claim.nii.gz claim.nii claim.nrrd claim.mha; do
     lines=$(wc -l <"$tmp/err.txt")
     written=$(ls -A "$tmp/out" | wc -l)
     [ "$(sha256sum "$in" | cut -d' ' -f1)" = "$sum" ] && same=yes || same=NO
-    printf '%-20s %-6s %8s %6s %9s %4s %5s %7s %9s  %s\n' "$f ($(stat -c %s "$in") B)" "$cmd" "$wall" "$cpu" "$rss" \
-      "$code" "$lines" "$written" "$same" "$(head -c 160 "$tmp/err.txt" | head -1)"
+    printf '%-20s %-6s %8s %6s %9s %4s %5s %7s %9s  %s\n' "$f ($(stat -c %s "$in") B)" "$cmd" \
+      "$wall" "$cpu" "$rss" "$code" "$lines" "$written" "$same" "$(head -1 "$tmp/err.txt")"
   done
 done

@@ -718,15 +718,21 @@ TEST(IoDicomFolder, ADataSetOpeningWithElement0000IsGuessedAsGdcmGuessesIt) {
          "byte 12 (GDCM asserts"},
         {"then an explicit private creator",
          after_null({0x09, 0, 0x10, 0, 'L', 'O', 2, 0, 'A', 'B'}),
+         "starts with element (0000,0000) "
          "followed by an explicit-VR element (0009,0010) at byte 12"},
         {"then an explicit element of another group",
          after_null({0x10, 0, 0x20, 0, 'L', 'O', 2, 0, 'A', 'B'}),
+         "starts with element (0000,0000) "
          "followed by an explicit-VR element (0010,0020) at byte 12"},
-        {"then ACR-NEMA big endian (implicit)", after_null({0, 0x08, 0, 0x16, 0, 0, 0, 2, 'a', 'b'}),
+        {"then ACR-NEMA big endian (implicit)",
+         after_null({0, 0x08, 0, 0x16, 0, 0, 0, 2, 'a', 'b'}),
+         "starts with element (0000,0000) "
          "followed by a big-endian element (0008,0016) at byte 12"},
         {"then a file meta group", after_null({2, 0, 1, 0, 'O', 'B', 0, 0, 2, 0, 0, 0, 0, 1}),
+         "starts with element (0000,0000) "
          "followed by a file meta group element (0002,0001) at byte 12"},
         {"the same after two of them", after_null({0x08, 0, 0x16, 0, 'U', 'I', 2, 0, '1', 0}, 2),
+         "starts with element (0000,0000) "
          "followed by an explicit-VR element (0008,0016) at byte 24"},
         {"17 of them", after_null({0x08, 0, 0x16, 0, 2, 0, 0, 0, '1', 0}, 17),
          "starts with more than 16 elements (0000,0000)"},
