@@ -101,7 +101,11 @@ Volume load_volume(const VolumeArgs& a) {
             std::string rest = a.range.substr(c + 1);
             float hi = std::stof(rest, &used);
             if (used != rest.size()) throw std::invalid_argument("x");
-            v.set_vis_range({lo, hi});
+            try {
+                v.set_vis_range({lo, hi});
+            } catch (const Error& e) {  // the library names the field; the user typed --range
+                throw Error(std::string("--range: ") + e.what());
+            }
         } catch (const std::logic_error&) {
             throw Error("--range", "range", "expected MIN:MAX numbers, got '" + a.range + "'");
         }

@@ -95,23 +95,11 @@ struct Setup {
     AccelOptions ao;  // the octree and bitfield flags, for structure_of()
 };
 
-// The structure `name` names for the renderer of `spec` ("auto": the renderer's default; the
-// segment renderer's "bitfield" is the label bitfield octree, the slicer's "boxes" the growing
-// boxes).
+// The structure `name` names for the renderer of `spec` (lacuna::parse_structure: "auto" is the
+// renderer's default, the segment renderer's "bitfield" the label octree).
 Structure structure_from(const std::string& name, const RenderArgs& a, const Setup& s) {
-    switch (s.spec.renderer) {
-        case Renderer::Segments:
-            if (name == "auto" || name == "bitfield") return structure::LabelOctree{a.leaf, a.bits};
-            break;
-        case Renderer::Slicer:
-            if (name == "auto") return structure::None{};
-            if (name == "boxes") return structure::GrowingBoxes{a.slice.coalesce, a.slice.coalesce_edge};
-            break;
-        case Renderer::RayMarcher:
-            if (name == "boxes") return structure::GrowingBoxes{a.slice.coalesce, a.slice.coalesce_edge};
-            break;
-    }
-    return structure_of(parse_accel(name), s.ao);
+    return parse_structure(name, s.spec.renderer, s.ao,
+                           structure::GrowingBoxes{a.slice.coalesce, a.slice.coalesce_edge});
 }
 
 Setup validate(RenderArgs& a) {
@@ -170,7 +158,7 @@ Setup validate(RenderArgs& a) {
     f.slicer.occlusion_threshold = a.slice.occlusion_threshold;
     f.slicer.occlusion_map = a.slice.occlusion_map;
     if (a.segments.active()) {
-        f.segments.mode = parse_segment_mode(a.segments.mode.empty() ? "mask" : a.segments.mode);
+        f.segments.mode = parse_segment_mode(a.segments.mode.empty() ? "mask" : a.segments.mode, "--segments");
         f.segments.tint = a.segments.tint;
     }
     s.ao.leaf_cells = a.leaf;

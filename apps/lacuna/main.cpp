@@ -2,12 +2,15 @@
 // code 2; usage errors exit 2 as well (docs/cli.md).
 #include <algorithm>
 #include <cstdio>
+
+#include "frame_flags.h"
 #include <exception>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "cli_common.h"
+#include "frame_flags.h"
 #include "lacuna/error.h"
 
 namespace {
@@ -67,6 +70,11 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::fprintf(stderr, "lacuna: %s (see --help)\n", e.what());
+        return 2;
+    } catch (const lacuna::FrameError& e) {
+        // The library names FrameSpec fields; the user typed flags (frame_flags.cpp).
+        std::fprintf(stderr, "lacuna: %s: %s: %s\n", lacuna::cli::flag_of_field(e.field()).c_str(),
+                     e.field().c_str(), e.expected().c_str());
         return 2;
     } catch (const lacuna::Error& e) {
         std::fprintf(stderr, "lacuna: %s\n", e.what());

@@ -6,8 +6,8 @@
 // One generic cursor (src/accel/cursor.h) turns those answers into the stretches of a ray that
 // may contain visible samples; the ray marcher samples only there, on the reference lattice.
 //
-// Adding a structure = one file in src/accel/, one AccelKind value, one factory case in
-// src/accel/accel.cpp; it is then in the conformance tests and the benchmarks automatically.
+// Adding a structure: see src/session/structure_registry.h (its names, kinds and faces are
+// listed there once); it is then in the conformance tests and the benchmarks automatically.
 #pragma once
 #include <memory>
 #include <optional>
@@ -33,7 +33,7 @@ enum class AccelKind {
 };
 
 std::string to_string(AccelKind k);
-// Throws lacuna::Error("--accel", "structure", "unknown 'x'; expected one of: ...").
+// Throws lacuna::FrameError("structure", "unknown 'x'; expected one of: ...").
 // "auto" names the default structure (default_accel()).
 AccelKind parse_accel(const std::string& name);
 // What `--accel auto` (the default of every front end) selects: the fastest exact structure in
@@ -55,7 +55,8 @@ std::vector<AccelKind> all_accel_kinds();
 //              exact for both; one built for Nearest only for Nearest (the renderers check).
 enum class Interpolation { Trilinear, Nearest };
 std::string to_string(Interpolation i);
-// Throws lacuna::Error("--interpolation", ...) for a name other than "trilinear" or "nearest".
+// Throws lacuna::FrameError("sampling.interpolation", ...) for a name other than "trilinear" or
+// "nearest".
 Interpolation parse_interpolation(const std::string& name);
 
 struct AccelOptions {

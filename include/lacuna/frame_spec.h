@@ -111,14 +111,24 @@ struct LabelOctree {
 
 }  // namespace structure
 
+// In the order of src/session/structure_registry.h (one entry per alternative): the order
+// accel_names(), the benchmarks' columns and the capabilities table's rows list them in.
 using Structure =
-    std::variant<structure::None, structure::MinMax, structure::MinMaxInterval,
-                 structure::Bitfield, structure::Boolean, structure::Distance,
-                 structure::Chebyshev, structure::KdTree, structure::Grid,
+    std::variant<structure::None, structure::Distance, structure::Chebyshev,
+                 structure::Boolean, structure::MinMax, structure::Bitfield,
+                 structure::KdTree, structure::MinMaxInterval, structure::Grid,
                  structure::GrowingBoxes, structure::LabelOctree>;
 
 // The structure's name: an accel_names() entry, "boxes" or "label-octree".
 std::string structure_name(const Structure& s);
+// The structure a front end's name names for renderer `r`: the one parser of `--accel`, the
+// viewer's "accel" and Python's structure=. "auto" is the renderer's default (the brick grid for
+// the ray marcher, the whole volume for the slicer, the label octree for the segment renderer);
+// the segment renderer's "bitfield" is its label octree; "boxes" the growing boxes; every other
+// name an accel_names() entry with its parameters from `o`. Throws FrameError("structure", ...)
+// listing the names for an unknown one (whether `r` takes it is validate()'s question).
+Structure parse_structure(const std::string& name, Renderer r, const AccelOptions& o = {},
+                          const structure::GrowingBoxes& boxes = {});
 // The ray-marching structures as AccelKind (GrowingBoxes and LabelOctree have none).
 std::optional<AccelKind> accel_kind(const Structure& s);
 // The structure of kind `k` with its parameters taken from `o` (the typed options the front
@@ -211,19 +221,7 @@ const std::vector<RendererCapabilities>& capabilities();
 const RendererCapabilities& capabilities(Renderer r);
 
 // ---- Validation ---------------------------------------------------------------------------------
-// The error of validate(): `field` is the FrameSpec field at fault ("sampling.step",
-// "features.shading", "structure"), `expected` what was expected and what was found. what() is
-// "frame: <field>: <expected>".
-class FrameError : public Error {
-public:
-    FrameError(std::string field, std::string expected);
-    const std::string& field() const { return m_field; }
-    const std::string& expected() const { return m_expected; }
-
-private:
-    std::string m_field, m_expected;
-};
-
+// The error of validate() is FrameError (lacuna/error.h): its field() names the FrameSpec field.
 // Throws FrameError for the first field out of range or not taken by the renderer
 // (capabilities()). Needs no volume: a front end calls it before loading anything.
 void validate(const FrameSpec& spec);

@@ -129,12 +129,17 @@ struct FeatureOptions {
 // Throws lacuna::Error (flag, field, what was expected) for out-of-range feature options.
 void validate_features(const FeatureOptions& f);
 
+// "Early termination off": an opacity front-to-back compositing never reaches (accumulated
+// opacity stays <= 1). The one number every renderer and bench means by it; FrameSpec's
+// Sampling::early_termination = nullopt becomes this (src/session/session.cpp).
+inline constexpr float kNoEarlyTermination = 2.f;
+
 struct RenderOptions {
     float step = 0.5f;        // sample distance in units of the smallest voxel spacing
     // Trilinear (default) or nearest-neighbour samples (lacuna/accel.h). A structure built for
     // Nearest is rejected with Trilinear (its sets with holes would not be exact).
     Interpolation interpolation = Interpolation::Trilinear;
-    float ert = 0.99f;        // early ray termination opacity; >= 1 turns it off
+    float ert = 0.99f;        // early ray termination opacity; >= 1 turns it off (kNoEarlyTermination)
     int threads = 0;          // 0 = all hardware threads
     Vec3f background{0, 0, 0};
     bool count_samples = false;  // fill RenderResult::sample_counts (for --heatmap)

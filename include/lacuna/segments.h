@@ -62,7 +62,7 @@ void set_label_visibility(LabelTable& table, const std::string& spec, bool visib
 
 enum class SegmentMode { Labels, Masked };
 std::string to_string(SegmentMode m);
-SegmentMode parse_segment_mode(const std::string& s, const std::string& where = "--segments");
+SegmentMode parse_segment_mode(const std::string& s, const std::string& where = "segments.mode");
 
 struct SegmentOptions {
     SegmentMode mode = SegmentMode::Masked;

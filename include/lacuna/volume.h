@@ -27,7 +27,7 @@ enum class VoxelType : uint8_t { UInt8, Int16, UInt16, Float32 };
 
 std::string to_string(VoxelType t);
 // Parses "uint8", "int16", "uint16", "float32" (also "float"); throws lacuna::Error otherwise.
-VoxelType parse_voxel_type(const std::string& name, const std::string& where = "--type");
+VoxelType parse_voxel_type(const std::string& name, const std::string& where = "type");
 size_t voxel_size(VoxelType t);
 
 template <class T> constexpr VoxelType voxel_type_of();

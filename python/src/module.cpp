@@ -71,9 +71,16 @@ constexpr std::pair<const char*, const char*> kKeywords[] = {
     {"structure.coalesce", "coalesce"},
     {"structure", "structure"},
     {"features.shading", "shading"},
+    {"features.phong", "phong"},
+    {"features.pbr", "pbr"},
     {"features.gradient_opacity", "gradient_opacity"},
+    {"features.light.intensity", "light_intensity"},
+    {"features.light", "light"},
+    {"features.shadows.step", "shadow_step"},
+    {"features.shadows.light_volume_stride", "light_volume_stride"},
     {"features.shadows", "shadows"},
     {"features.clip_planes", "clip"},
+    {"features.crop_box", "crop"},
     {"features.crop", "crop"},
     {"features.blend", "blend"},
     {"features.jitter", "jitter"},
@@ -99,19 +106,9 @@ std::string keyword_of_field(const std::string& field) {
     return keyword;
 }
 
-// A FrameError as the Python user's line: "<keyword>: <field>: <expected>". validate_features
-// (src/render/feature_render.cpp) still names CLI flags inside "features"; its "--gradient-opacity"
-// becomes the keyword "gradient_opacity".
+// A FrameError as the Python user's line: "<keyword>: <field>: <expected>".
 std::string python_message(const lacuna::FrameError& e) {
-    const std::string& x = e.expected();
-    if (e.field() == "features" && x.rfind("--", 0) == 0) {
-        const size_t colon = x.find(':');
-        std::string keyword =
-            x.substr(2, colon == std::string::npos ? std::string::npos : colon - 2);
-        std::replace(keyword.begin(), keyword.end(), '-', '_');
-        return keyword + (colon == std::string::npos ? "" : x.substr(colon));
-    }
-    return keyword_of_field(e.field()) + ": " + e.field() + ": " + x;
+    return keyword_of_field(e.field()) + ": " + e.field() + ": " + e.expected();
 }
 
 // ---- Volume -------------------------------------------------------------------------------------
@@ -439,7 +436,7 @@ class Kwargs {
     std::vector<std::string> m_used;
 };
 
-// The structure a name names for the renderer (the CLI's structure_from in cmd_render.cpp).
+// The structure a name names for the renderer (lacuna::parse_structure, as the CLI and the viewer).
 lacuna::Structure structure_from(const std::string& name, lacuna::Renderer r, Kwargs& kw) {
     lacuna::AccelOptions ao;
     ao.leaf_cells = kw.get<int>("leaf", 8);
@@ -448,27 +445,10 @@ lacuna::Structure structure_from(const std::string& name, lacuna::Renderer r, Kw
     ao.bidirectional = !kw.get<bool>("top_down", false);
     const lacuna::structure::GrowingBoxes boxes{kw.get<float>("coalesce", 0.25f),
                                                 kw.get<float>("coalesce_edge", 64.f)};
-    switch (r) {
-        case lacuna::Renderer::Segments:
-            if (name == "auto" || name == "bitfield" || name == "label-octree")
-                return lacuna::structure::LabelOctree{ao.leaf_cells, ao.bitfield_bits};
-            break;
-        case lacuna::Renderer::Slicer:
-            if (name == "auto") return lacuna::structure::None{};
-            if (name == "boxes") return boxes;
-            break;
-        case lacuna::Renderer::RayMarcher:
-            if (name == "boxes") return boxes;
-            break;
-    }
     try {
-        return lacuna::structure_of(lacuna::parse_accel(name), ao);
-    } catch (const Error&) {
-        std::string names;
-        for (const auto& n : lacuna::accel_names()) names += (names.empty() ? "" : ", ") + n;
-        value_error(
-            "structure", "structure",
-            "unknown '" + name + "'; expected one of: auto, " + names + ", boxes, label-octree");
+        return lacuna::parse_structure(name, r, ao, boxes);  // the one parser of structure names
+    } catch (const lacuna::FrameError& e) {
+        value_error("structure", "structure", e.expected());
     }
 }
 

@@ -21,7 +21,7 @@ BitfieldOctree::BitfieldOctree(const Volume& v, const AccelOptions& o)
     : OctreeBase(AccelKind::Bitfield, v, o) {
     const int b = o.bitfield_bits;
     if (b != 8 && b != 16 && b != 32 && b != 64 && b != 128)
-        throw Error("--bits", "bitfield width", "expected 8, 16, 32, 64 or 128, got " + std::to_string(b));
+        throw FrameError("structure.bits", "expected 8, 16, 32, 64 or 128, got " + std::to_string(b));
     m_nbits = b;
     m_words = b > 64 ? 2 : 1;
     m_interpolation = o.interpolation;

@@ -52,7 +52,7 @@ void edt_1d(const float* f, float* d, int n, int* v, float* z) {
 DistanceMap::DistanceMap(AccelKind kind, const Volume& v, const AccelOptions& o)
     : Accel(kind), m_volume(v), m_opts(o), m_block(o.distance_block) {
     if (m_block < 1 || m_block > 64)
-        throw Error("--distance-block", "block size", "expected 1..64 cells");
+        throw FrameError("structure.block", "expected 1..64 cells");
     cell_counts(v, m_cells);
     for (int a = 0; a < 3; ++a) m_nb[a] = (m_cells[a] + m_block - 1) / m_block;
     m_radius.assign(size_t(m_nb[0]) * m_nb[1] * m_nb[2], 0);

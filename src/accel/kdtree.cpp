@@ -17,9 +17,9 @@ int* grid_cells(const Volume& v, int c[3]) {
 KdTree::KdTree(const Volume& v, const AccelOptions& o)
     : Accel(AccelKind::KdTree), m_volume(v), m_settings(kd_settings(o)) {
     if (o.kd_threshold)
-        throw Error("--threshold", "classification",
-                    "a value threshold is for `lacuna partition` only; rendering with --accel "
-                    "kdtree classifies cells by the transfer function");
+        throw FrameError("structure.threshold",
+                         "a value threshold is for `lacuna partition` only; rendering with the "
+                         "kd-tree classifies cells by the transfer function");
     // Nothing is TF-independent; until the first TF every cell may be visible.
     int c[3];
     m_part = KdPartition(grid_cells(v, c));

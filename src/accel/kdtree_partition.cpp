@@ -134,20 +134,20 @@ int default_kd_delta(const int cells[3]) {
 KdSettings kd_settings(const AccelOptions& o) {
     KdSettings s;
     if (o.kd_max_boxes < 0)
-        throw Error("--max-boxes", "M",
-                    "expected >= 0 (0 = every leaf), got " + std::to_string(o.kd_max_boxes));
+        throw FrameError("structure.max_boxes",
+                         "expected >= 0 (0 = every leaf), got " + std::to_string(o.kd_max_boxes));
     if (o.kd_delta < 0)
-        throw Error("--delta", "candidate plane spacing",
-                    "expected >= 1 cells (0 = from the size), got " + std::to_string(o.kd_delta));
+        throw FrameError("structure.delta",
+                         "expected >= 1 cells (0 = from the size), got " + std::to_string(o.kd_delta));
     if (!(o.kd_min_volume >= 0.f && o.kd_min_volume <= 1.f))
-        throw Error("--min-volume", "fraction",
-                    "expected 0..1, got " + std::to_string(o.kd_min_volume));
+        throw FrameError("structure.min_volume",
+                         "expected 0..1, got " + std::to_string(o.kd_min_volume));
     if (!(o.kd_min_gain >= 0.f && o.kd_min_gain <= 1.f))
-        throw Error("--min-gain", "fraction",
-                    "expected 0..1, got " + std::to_string(o.kd_min_gain));
+        throw FrameError("structure.min_gain",
+                         "expected 0..1, got " + std::to_string(o.kd_min_gain));
     if (o.kd_max_depth < 0 || o.kd_max_depth > 64)
-        throw Error("--max-depth", "depth",
-                    "expected 0..64, got " + std::to_string(o.kd_max_depth));
+        throw FrameError("structure.max_depth",
+                         "expected 0..64, got " + std::to_string(o.kd_max_depth));
     s.max_boxes = o.kd_max_boxes;
     s.delta = o.kd_delta;
     s.min_volume = o.kd_min_volume;

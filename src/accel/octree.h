@@ -27,8 +27,8 @@ struct Pyramid {
 
     void init(const int c[3], int leaf) {
         if (leaf < 2 || leaf > 64 || (leaf & (leaf - 1)))
-            throw Error("--leaf", "leaf size", "expected a power of two in 2..64, got " +
-                                                   std::to_string(leaf));
+            throw FrameError("structure.octree.leaf_cells",
+                             "expected a power of two in 2..64, got " + std::to_string(leaf));
         leaf_log2 = 0;
         while ((1 << leaf_log2) < leaf) ++leaf_log2;
         for (int a = 0; a < 3; ++a) cells[a] = c[a];

@@ -217,7 +217,7 @@ RenderOptions row_render_options(const FaludiOptions& o, RowMode m, const Box3f&
     RenderOptions ro;
     ro.step = o.step;
     ro.interpolation = o.interpolation;
-    ro.ert = m == RowMode::MarchingOnly ? 2.f : o.ert;
+    ro.ert = m == RowMode::MarchingOnly ? kNoEarlyTermination : o.ert;
     ro.threads = o.threads;
     if (m == RowMode::Shading || m == RowMode::Lighting) {
         // The paper's model (Section 4.4): Disney diffuse, GGX, Smith joint GGX, Schlick.

@@ -22,7 +22,7 @@ using LogFn = std::function<void(const std::string&)>;
 
 // The paper's shader configurations.
 enum class RowMode {
-    MarchingOnly,  // early ray termination off (RenderOptions::ert = 2, never reached)
+    MarchingOnly,  // early ray termination off (RenderOptions::ert = kNoEarlyTermination)
     EarlyExit,     // early ray termination at FaludiOptions::ert
     Shading,       // + the paper's PBR shading (on-the-fly gradients) with a headlight
     Lighting,      // + a spotlight with shadow rays through the structure (src/bench/faludi.cpp)
@@ -64,7 +64,7 @@ struct CellResult {
 
 struct RowResult {
     RowMode mode = RowMode::MarchingOnly;
-    float ert = 2.f;
+    float ert = kNoEarlyTermination;
     uint64_t ideal_samples = 0;     // visible-cell samples over the orbit (0: not computed)
     double ideal_seconds = 0;       // time the count took
     std::vector<CellResult> cells;  // none first, then FaludiOptions::accels order

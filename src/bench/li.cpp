@@ -80,7 +80,7 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
             for (size_t v = 0; v < cams.size(); ++v) {
                 SliceOptions so;
                 so.step = o.step;
-                so.ert = 2.f;  // no per-pixel termination: the paper's GPU has none
+                so.ert = kNoEarlyTermination;  // no per-pixel termination: the paper's GPU has none
                 so.threads = o.threads;
                 so.occlusion.mode = mode;
                 so.occlusion.threshold = o.threshold;
@@ -123,7 +123,7 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
             m.set_transfer_function(ds.lut);
             RenderOptions ro;
             ro.step = o.step;
-            ro.ert = 2.f;
+            ro.ert = kNoEarlyTermination;
             ro.threads = o.threads;
             std::vector<std::pair<std::string, std::unique_ptr<Accel>>> accels;
             accels.push_back({"march none", nullptr});
@@ -160,7 +160,7 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
             for (const Camera& cam : long_orbit) {
                 SliceOptions so;
                 so.step = o.step;
-                so.ert = 2.f;
+                so.ert = kNoEarlyTermination;
                 so.threads = o.threads;
                 so.occlusion.mode = OcclusionMode::CullClip;
                 so.occlusion.threshold = o.threshold;

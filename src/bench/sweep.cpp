@@ -109,7 +109,7 @@ SweepResult run_sweep(const std::vector<BenchDataset>& datasets, const SweepOpti
     res.options = o;
     RenderOptions ro;
     ro.step = o.step;
-    ro.ert = 2.f;  // Figures 4 and 6: early ray termination off
+    ro.ert = kNoEarlyTermination;  // Figures 4 and 6: early ray termination off
     ro.threads = o.threads;
     struct Setup {
         std::unique_ptr<RayMarcher> marcher;

@@ -73,7 +73,7 @@ struct Context {
     const HalfSpace* clips = nullptr; // the clipping half-spaces (plane 0 excluded when two_tfs)
     int n_clips = 0;
     float crop_lo[3] = {}, crop_hi[3] = {};  // index space
-    float step = 0.5f, dt = 0, dts = 0, ert = 2.f;
+    float step = 0.5f, dt = 0, dts = 0, ert = kNoEarlyTermination;
     Vec3f sp{1, 1, 1}, inv_sp{1, 1, 1};
     bool nearest = false;             // Interpolation::Nearest: value() reads the nearest voxel
     bool need_gradient = false;

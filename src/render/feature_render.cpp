@@ -22,39 +22,40 @@ bool finite3(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::
 }  // namespace
 
 void validate_features(const FeatureOptions& f) {
-    auto fail = [](const char* opt, const char* what, const std::string& expected) {
-        throw Error(opt, what, expected);
+    // Errors name FeatureOptions' fields as FrameSpec holds them (FrameSpec::features).
+    auto fail = [](const char* field, const std::string& expected) {
+        throw FrameError(field, expected);
     };
     const PhongParams& p = f.phong;
     if (!(p.ambient >= 0 && p.diffuse >= 0 && p.specular >= 0 && p.power >= 0) ||
         !std::isfinite(p.ambient + p.diffuse + p.specular + p.power))
-        fail("--phong", "parameters", "expected finite ambient, diffuse, specular, power >= 0");
+        fail("features.phong", "expected finite ambient, diffuse, specular, power >= 0");
     if (!(f.pbr.roughness > 0 && f.pbr.roughness <= 1) || !(f.pbr.metallic >= 0 && f.pbr.metallic <= 1) ||
         !(f.pbr.ambient >= 0 && std::isfinite(f.pbr.ambient)))
-        fail("--pbr", "parameters", "expected roughness in (0,1], metallic in [0,1], ambient >= 0");
+        fail("features.pbr", "expected roughness in (0,1], metallic in [0,1], ambient >= 0");
     if (f.gradient_opacity.enabled &&
         !(f.gradient_opacity.lo >= 0 && f.gradient_opacity.lo <= f.gradient_opacity.hi &&
           std::isfinite(f.gradient_opacity.hi)))
-        fail("--gradient-opacity", "ramp", "expected 0 <= LO <= HI");
+        fail("features.gradient_opacity", "expected 0 <= LO <= HI");
     const Light& l = f.light;
     if (!(l.intensity >= 0 && std::isfinite(l.intensity)))
-        fail("--light", "intensity", "expected a finite intensity >= 0");
+        fail("features.light.intensity", "expected a finite intensity >= 0");
     if (l.kind == LightKind::Directional && !(finite3(l.direction) && length(l.direction) > 0))
-        fail("--light", "direction", "expected a finite non-zero direction");
+        fail("features.light.direction", "expected a finite non-zero direction");
     if (l.kind == LightKind::Spot &&
         (!finite3(l.position) || !finite3(l.target) || !(length(l.target - l.position) > 0) ||
          !(l.cone_deg > 0 && l.cone_deg < 90)))
-        fail("--light", "spot", "expected position != target and a cone half-angle in (0, 90) degrees");
+        fail("features.light", "expected position != target and a cone half-angle in (0, 90) degrees");
     if (!(f.shadows.step > 0 && f.shadows.step <= 64))
-        fail("--shadow-step", "step", "expected 0 < step <= 64");
+        fail("features.shadows.step", "expected 0 < step <= 64");
     if (f.shadows.light_volume_stride < 1 || f.shadows.light_volume_stride > 64)
-        fail("--light-volume", "stride", "expected 1..64");
+        fail("features.shadows.light_volume_stride", "expected 1..64");
     for (const ClipPlane& c : f.clip_planes)
         if (!finite3(c.normal) || !(length(c.normal) > 0) || !std::isfinite(c.d))
-            fail("--clip", "plane", "expected a finite non-zero normal and a finite offset");
+            fail("features.clip_planes", "expected a finite non-zero normal and a finite offset");
     if (f.crop && !(finite3(f.crop_box.lo) && finite3(f.crop_box.hi) && f.crop_box.lo.x <= f.crop_box.hi.x &&
                     f.crop_box.lo.y <= f.crop_box.hi.y && f.crop_box.lo.z <= f.crop_box.hi.z))
-        fail("--crop", "box", "expected x0 <= x1, y0 <= y1, z0 <= z1");
+        fail("features.crop_box", "expected x0 <= x1, y0 <= y1, z0 <= z1");
 }
 
 namespace {
@@ -105,7 +106,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
     validate_features(f);
     const bool two_tfs = !m_back_lut.entries.empty();
     if (two_tfs && f.clip_planes.empty())
-        throw Error("--tf-back", "clip plane", "a back TF needs a clip plane (--clip) to split at");
+        throw FrameError("two_tfs", "expected a clip plane to split the two TFs at");
     if (two_tfs) union_lut(m_lut, m_back_lut);  // throws if the LUTs are incompatible
 
     RenderResult out;

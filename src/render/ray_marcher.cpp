@@ -81,8 +81,8 @@ std::string to_string(BlendMode m) {
 
 TransferLut union_lut(const TransferLut& a, const TransferLut& b) {
     if (a.size() != b.size() || a.vis.min != b.vis.min || a.vis.max != b.vis.max)
-        throw Error("--tf-back", "transfer function",
-                    "expected the same LUT size and visualization range as --tf");
+        throw FrameError("two_tfs", "expected a back TF with the front TF's LUT size and "
+                                    "visualization range");
     TransferLut u = a;
     for (size_t e = 0; e < u.entries.size(); ++e)
         u.entries[e].a = std::max(a.entries[e].a, b.entries[e].a);
@@ -218,20 +218,20 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
 RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& world_opt) const {
     if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
     if (!m_back_lut.entries.empty() && world_opt.features.clip_planes.empty())
-        throw Error("--tf-back", "clip plane", "a back TF needs a clip plane (--clip) to split at");
+        throw FrameError("two_tfs", "expected a clip plane to split the two TFs at");
     // 0. World (RAS) -> the volume frame, where everything below works (lacuna/orientation.h).
     const VolumeFrame vf = volume_frame(m_volume);
     const Camera cam = to_volume_frame(vf, world_cam);
     RenderOptions mapped;
     const RenderOptions& opt = to_volume_frame(vf, world_opt, mapped);
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
-        throw Error("--step", "step", "expected a positive number");
+        throw FrameError("sampling.step", "expected a positive number");
     if (cam.width() < 1 || cam.height() < 1)
-        throw Error("--size", "image size", "expected at least 1x1 pixels");
+        throw FrameError("width", "expected at least 1x1 pixels");
     if (m_accel && m_accel->interpolation() == Interpolation::Nearest &&
         opt.interpolation != Interpolation::Nearest)
-        throw Error("--interpolation", "sampling",
-                    "the structure was built for nearest sampling; expected --interpolation nearest");
+        throw FrameError("sampling.interpolation",
+                         "the structure was built for nearest sampling; expected nearest");
     if (opt.features.any()) return render_features(cam, opt);
     RenderResult out;
     out.image = Image(cam.width(), cam.height());

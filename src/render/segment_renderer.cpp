@@ -138,9 +138,9 @@ SegmentRenderer::SegmentRenderer(const Volume* intensity, const Volume& labels,
                                  const SegmentOptions& options)
     : m_impl(std::make_unique<Impl>(intensity, labels, options)) {
     if (options.mode == SegmentMode::Masked && !intensity)
-        throw Error("--segments", "mode", "mask mode needs an intensity volume and --labels");
+        throw FrameError("segments.mode", "mask mode needs an intensity volume and a label volume");
     if (!(options.tint >= 0.f && options.tint <= 1.f))
-        throw Error("--label-tint", "tint", "expected a number in [0,1]");
+        throw FrameError("segments.tint", "expected a number in [0,1]");
     check_label_volume(labels, intensity, "labels");
     if (options.skip) {
         const auto t0 = std::chrono::steady_clock::now();
@@ -178,8 +178,8 @@ void SegmentRenderer::set_labels(const LabelTable& t) {
 
 void SegmentRenderer::set_accel(const Accel* accel) {
     if (accel && (m_impl->octree || m_impl->opts.mode != SegmentMode::Masked))
-        throw Error("--accel", "segments",
-                    "an intensity structure applies to mask mode without the label octree");
+        throw FrameError("structure",
+                         "an intensity structure applies to mask mode without the label octree");
     m_impl->accel = accel;
 }
 
@@ -195,11 +195,11 @@ RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOption
     if (masked && im.lut.entries.empty())
         throw Error("render", "transfer function", "none was set (mask mode)");
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
-        throw Error("--step", "step", "expected a positive number");
+        throw FrameError("sampling.step", "expected a positive number");
     if (im.accel && im.accel->interpolation() == Interpolation::Nearest &&
         opt.interpolation != Interpolation::Nearest)
-        throw Error("--interpolation", "sampling",
-                    "the structure was built for nearest sampling; expected --interpolation nearest");
+        throw FrameError("sampling.interpolation",
+                         "the structure was built for nearest sampling; expected nearest");
     RenderResult out;
     out.image = Image(cam.width(), cam.height());
     if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);

@@ -52,7 +52,7 @@ FrameRenderer::FrameRenderer(Volume volume, const AccelOptions& accel_options, i
 FrameRenderer::~FrameRenderer() = default;
 
 void FrameRenderer::set_labels(Volume labels) {
-    check_label_volume(labels, &m_session->volume(), "--labels");
+    check_label_volume(labels, &m_session->volume(), "labels");
     m_session->set_labels(std::move(labels));
 }
 

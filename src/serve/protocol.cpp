@@ -171,8 +171,8 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     r.renderer = renderer == "slice" ? RendererKind::Slice : RendererKind::March;
     try {
         r.accel = parse_accel(text_of(j, "accel", ""));
-    } catch (const Error& e) {
-        reject("accel", e.what());
+    } catch (const FrameError& e) {  // the page's field is "accel"
+        reject("accel", e.expected());
     }
     r.ert = boolean(j, "ert", "");
     // Optional toggles (absent = off): Phong shading with a headlight, and a clip plane through
@@ -256,9 +256,7 @@ Renderer frame_renderer(RendererKind renderer, bool segments) {
 }
 
 Structure frame_structure(AccelKind accel, bool segments, const AccelOptions& o) {
-    if (segments && accel == AccelKind::Bitfield)
-        return structure::LabelOctree{o.leaf_cells, o.bitfield_bits};
-    return structure_of(accel, o);
+    return parse_structure(to_string(accel), segments ? Renderer::Segments : Renderer::RayMarcher, o);
 }
 
 std::optional<uint64_t> request_id(std::string_view text, const Limits& limits) {

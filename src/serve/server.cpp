@@ -576,7 +576,7 @@ uint16_t Server::start() {
     boost::system::error_code ec;
     const auto address = net::ip::make_address(m->options.host, ec);
     if (ec)
-        throw Error("--host", "address", "expected an IP address, got '" + m->options.host + "'");
+        throw Error("serve", "host", "expected an IP address, got '" + m->options.host + "'");
     m->loopback = address.is_loopback();
     const tcp::endpoint ep{address, m->options.port};
     const std::string where = m->options.host + ":" + std::to_string(m->options.port);
@@ -584,7 +584,7 @@ uint16_t Server::start() {
     if (!ec) m->acceptor.set_option(net::socket_base::reuse_address(true), ec);
     if (!ec) m->acceptor.bind(ep, ec);
     if (!ec) m->acceptor.listen(net::socket_base::max_listen_connections, ec);
-    if (ec) throw Error("--port", where, "cannot listen: " + ec.message());
+    if (ec) throw Error("serve", "port", where + ": cannot listen: " + ec.message());
     m->port = m->acceptor.local_endpoint().port();
     m->accept();
     if (m->options.handle_signals) {

@@ -68,7 +68,7 @@ class Server {
     Server(const Server&) = delete;
     Server& operator=(const Server&) = delete;
 
-    // Binds and listens. Throws lacuna::Error("--host"/"--port", ...) if that fails.
+    // Binds and listens. Throws lacuna::Error("serve", "host"/"port", ...) if that fails.
     // Returns the port (the chosen one when options.port is 0).
     uint16_t start();
     // Serves until stop() (or a signal with handle_signals). Call after start().

@@ -25,21 +25,43 @@ std::string structure_name(const Structure& s) { return registry::entry(s).name;
 std::optional<AccelKind> accel_kind(const Structure& s) { return registry::entry(s).ray; }
 
 Structure structure_of(AccelKind k, const AccelOptions& o) {
-    const structure::Octree oct{o.leaf_cells, o.initial_level, o.bidirectional};
-    switch (k) {
-        case AccelKind::None: return structure::None{};
-        case AccelKind::MinMax: return structure::MinMax{oct};
-        case AccelKind::MinMaxInterval: return structure::MinMaxInterval{oct};
-        case AccelKind::Bitfield: return structure::Bitfield{oct, o.bitfield_bits};
-        case AccelKind::Boolean: return structure::Boolean{oct};
-        case AccelKind::Distance: return structure::Distance{o.distance_block};
-        case AccelKind::Chebyshev: return structure::Chebyshev{o.distance_block};
-        case AccelKind::KdTree:
-            return structure::KdTree{o.kd_max_boxes, o.kd_delta, o.kd_min_volume, o.kd_min_gain,
-                                     o.kd_max_depth};
-        case AccelKind::Grid: return structure::Grid{};
-    }
-    return structure::None{};
+    // The alternative whose registry entry has kind k, its parameters from o (the inverse of
+    // accel_options below).
+    Structure out = structure::None{};
+    [&]<size_t... I>(std::index_sequence<I...>) {
+        (
+            [&] {
+                using T = std::variant_alternative_t<I, Structure>;
+                if (registry::kStructures[I].ray != k) return;
+                T v{};
+                if constexpr (kHasOctree<T>)
+                    v.octree = {o.leaf_cells, o.initial_level, o.bidirectional};
+                if constexpr (std::is_same_v<T, structure::Bitfield>) v.bits = o.bitfield_bits;
+                if constexpr (std::is_same_v<T, structure::Distance> ||
+                              std::is_same_v<T, structure::Chebyshev>)
+                    v.block = o.distance_block;
+                if constexpr (std::is_same_v<T, structure::KdTree>)
+                    v = {o.kd_max_boxes, o.kd_delta, o.kd_min_volume, o.kd_min_gain, o.kd_max_depth};
+                out = v;
+            }(),
+            ...);
+    }(std::make_index_sequence<std::variant_size_v<Structure>>{});
+    return out;
+}
+
+Structure parse_structure(const std::string& name, Renderer r, const AccelOptions& o,
+                          const structure::GrowingBoxes& boxes) {
+    const structure::LabelOctree label_octree{o.leaf_cells, o.bitfield_bits};
+    if (r == Renderer::Segments && (name == "auto" || name == "bitfield")) return label_octree;
+    if (r == Renderer::Slicer && name == "auto") return structure::None{};
+    if (name == "auto") return structure_of(default_accel(), o);
+    if (name == "boxes") return boxes;
+    if (name == "label-octree") return label_octree;
+    for (const registry::Entry& e : registry::kStructures)
+        if (e.ray && name == e.name) return structure_of(*e.ray, o);
+    std::string valid = "auto";
+    for (const registry::Entry& e : registry::kStructures) valid += std::string(", ") + e.name;
+    throw FrameError("structure", "unknown '" + name + "'; expected one of: " + valid);
 }
 
 std::optional<AccelOptions> accel_options(const Structure& s, Interpolation interpolation,
@@ -126,7 +148,7 @@ const std::vector<RendererCapabilities>& capabilities() {
         std::vector<std::string> ray, boxes, segments, intensity;
         for (const registry::Entry& e : registry::kStructures) {
             if (e.ray) ray.push_back(e.name);
-            if (e.boxes) boxes.push_back(e.name);
+            if (e.boxes()) boxes.push_back(e.name);
             if (e.ray && *e.ray != AccelKind::None) intensity.push_back(e.name);
             if (e.labels || e.ray) segments.push_back(e.name);
         }
@@ -150,9 +172,6 @@ const std::vector<RendererCapabilities>& capabilities() {
 const RendererCapabilities& capabilities(Renderer r) { return capabilities()[size_t(r)]; }
 
 // ---- Validation ---------------------------------------------------------------------------------
-FrameError::FrameError(std::string field, std::string expected)
-    : Error("frame", field, expected), m_field(std::move(field)), m_expected(std::move(expected)) {}
-
 namespace {
 
 [[noreturn]] void fail(const std::string& field, const std::string& expected) {
@@ -264,12 +283,7 @@ void validate(const FrameSpec& s) {
             fail(field, "the " + to_string(s.renderer) + " renderer has no " + to_string(feature));
     if (s.two_tfs && s.features.clip_planes.empty())
         fail("two_tfs", "expected a clip plane to split the two TFs at");
-    try {
-        validate_features(s.features);
-    } catch (const Error& e) {
-        // validate_features (src/render/feature_render.cpp) still names the CLI's flags.
-        fail("features", e.what());
-    }
+    validate_features(s.features);  // its FrameErrors name "features.phong" ... itself
     // 5. The slicer's and the segments' own options.
     if (s.renderer == Renderer::Slicer) {
         if (!(s.slicer.occlusion_threshold > 0.f && s.slicer.occlusion_threshold <= 1.f))

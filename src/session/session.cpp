@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/check.h"
 #include "lacuna/error.h"
 #include "lacuna/orientation.h"
 #include "session/structure_registry.h"
@@ -20,11 +21,8 @@ double seconds_since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// What the renderers take for "early termination off": an opacity compositing never reaches
-// (accumulated opacity stays <= 1). The one place FrameSpec's nullopt becomes a number.
-constexpr float kNoTermination = 2.f;
-
-float ert_of(const Sampling& s) { return s.early_termination.value_or(kNoTermination); }
+// The one place FrameSpec's nullopt becomes the renderers' "off" (lacuna/renderer.h).
+float ert_of(const Sampling& s) { return s.early_termination.value_or(kNoEarlyTermination); }
 
 // Something built for some TF: it holds version `version` of the session's TF, as the front LUT
 // alone or (two_tfs) as the union of front and back.
@@ -164,6 +162,8 @@ Accel& Session::intensity_structure(const FrameSpec& spec, FrameResult& out) {
     for (auto& b : s.accels)
         if (b.structure == spec.structure && b.interpolation == interp) found = &b;
     if (!found) {
+        // validate() granted this renderer the structure, so it has a ray face.
+        LACUNA_CHECK(accel_kind(spec.structure).has_value());
         const auto t0 = Clock::now();
         auto accel = make_accel(*accel_kind(spec.structure), *m_volume,
                                 *accel_options(spec.structure, interp, m_threads));
@@ -218,8 +218,7 @@ void Session::prepare_slicer(const FrameSpec& spec, FrameResult& out) {
     for (auto& b : s.sources)
         if (b.structure == spec.structure) found = &b;
     if (!found) {
-        // The box face by the registry's name (box_source_names()), with the structure's
-        // parameters.
+        // The registry's box face, with the structure's parameters.
         const auto t0 = Clock::now();
         AccelOptions ao;
         ao.threads = m_threads;
@@ -230,8 +229,9 @@ void Session::prepare_slicer(const FrameSpec& spec, FrameResult& out) {
             bo.coalesce = gb->coalesce;
             bo.coalesce_edge = gb->coalesce_edge;
         }
-        s.sources.push_back(
-            {spec.structure, make_box_source(registry::entry(spec.structure).name, *m_volume, ao, bo), {}});
+        const registry::Entry& e = registry::entry(spec.structure);
+        LACUNA_CHECK(e.make_boxes != nullptr);  // validate(): the slicer takes box faces only
+        s.sources.push_back({spec.structure, e.make_boxes(*m_volume, ao, bo), {}});
         out.build_seconds += seconds_since(t0);
         found = &s.sources.back();
     }
@@ -369,6 +369,7 @@ FrameResult Session::render(const FrameSpec& spec) {
             break;
         }
         case Renderer::Segments: {
+            LACUNA_CHECK(s.current_segments != nullptr);  // prepare_segments set it
             SegmentRenderer& seg = *s.current_segments;
             seg.set_labels(spec.segments.labels ? *spec.segments.labels : label_table());
             r = seg.render(cam, render_options(spec, m_threads));

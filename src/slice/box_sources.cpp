@@ -2,7 +2,7 @@
 
 #include "accel/kdtree.h"
 #include "lacuna/error.h"
-#include "slice/growing_boxes_source.h"
+#include "session/structure_registry.h"
 
 namespace lacuna {
 
@@ -31,20 +31,24 @@ class KdTreeBoxSource final : public BoxSource {
 
 }  // namespace
 
-std::vector<std::string> box_source_names() { return {"none", "kdtree", "boxes"}; }
+std::unique_ptr<BoxSource> make_kdtree_box_source(const Volume& volume, const AccelOptions& options) {
+    return std::make_unique<KdTreeBoxSource>(volume, options);
+}
+
+std::vector<std::string> box_source_names() {
+    std::vector<std::string> out;
+    for (const registry::Entry& e : registry::kStructures)
+        if (e.boxes()) out.push_back(e.name);
+    return out;
+}
 
 std::unique_ptr<BoxSource> make_box_source(const std::string& name, const Volume& volume,
                                            const AccelOptions& options, const BoxesOptions& boxes) {
-    if (name == "none") return std::make_unique<VolumeBoxSource>(volume);
-    if (name == "kdtree") return std::make_unique<KdTreeBoxSource>(volume, options);
-    if (name == "boxes") {
-        BoxesOptions bo = boxes;
-        bo.threads = options.threads;
-        validate(bo);
-        return make_growing_boxes_source(volume, bo);
-    }
-    throw Error("--accel", "box source",
-                "the slice renderer takes none, kdtree or boxes, not '" + name + "'");
+    if (const registry::Entry* e = registry::find(name); e && e->make_boxes)
+        return e->make_boxes(volume, options, boxes);
+    std::string valid;
+    for (const std::string& n : box_source_names()) valid += (valid.empty() ? "" : ", ") + n;
+    throw FrameError("structure", "the slice renderer takes " + valid + ", not '" + name + "'");
 }
 
 }  // namespace lacuna

@@ -26,10 +26,15 @@ class VolumeBoxSource final : public BoxSource {
     CellBox m_box;
 };
 
-// Names make_box_source accepts.
+// The kd-tree paper's subvolume list (Section 2.2) as the slicer renders it: the list boxes, near
+// child of every split first.
+std::unique_ptr<BoxSource> make_kdtree_box_source(const Volume& volume, const AccelOptions& options);
+
+// Names make_box_source accepts: the registry's structures with a box face
+// (src/session/structure_registry.h).
 std::vector<std::string> box_source_names();
-// Builds the source `name` over `volume` (which must outlive it). Throws lacuna::Error
-// ("--accel", "box source", ...) for an unknown name or one the slicer cannot use.
+// Builds the source `name` over `volume` (which must outlive it). Throws lacuna::FrameError
+// ("structure", ...) for an unknown name or one the slicer cannot use.
 // "boxes" takes `boxes` (the paper's settings by default; its threads come from `options`).
 std::unique_ptr<BoxSource> make_box_source(const std::string& name, const Volume& volume,
                                            const AccelOptions& options = {},

@@ -276,24 +276,29 @@ std::string to_string(const CellBox& b) {
 }
 
 void validate(const BoxesOptions& o) {
-    auto bad = [](const char* opt, const char* what, double got) {
+    // Fields as FrameSpec's growing boxes and `lacuna partition` hold them ("structure.spread");
+    // the CLI names its flags (apps/lacuna/frame_flags.cpp).
+    auto bad = [](const char* field, const char* what, double got) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "%g", got);
-        return Error(opt, "value", std::string("expected ") + what + ", got " + buf);
+        return FrameError(field, std::string("expected ") + what + ", got " + buf);
     };
-    if (!(o.spread >= 0.f && o.spread <= 256.f)) throw bad("--spread", "0..256 (256ths)", o.spread);
+    if (!(o.spread >= 0.f && o.spread <= 256.f))
+        throw bad("structure.spread", "0..256 (256ths)", o.spread);
     if (o.min_uniform < 1 || o.min_uniform > 4096)
-        throw bad("--min-box", "1..4096 cells", o.min_uniform);
+        throw bad("structure.min_uniform", "1..4096 cells", o.min_uniform);
     if (!(o.gradient >= 0.f && o.gradient <= 1.f))
-        throw bad("--gradient", "0..1 (of the full scale per voxel)", o.gradient);
+        throw bad("structure.gradient", "0..1 (of the full scale per voxel)", o.gradient);
     if (!(o.gradient_waste >= 0.f && o.gradient_waste <= 1.f))
-        throw bad("--gradient-waste", "0..1", o.gradient_waste);
+        throw bad("structure.gradient_waste", "0..1", o.gradient_waste);
     if (!(o.other_cost >= 0.f && std::isfinite(o.other_cost)))
-        throw bad("--other-cost", "a finite value >= 0 (cells)", o.other_cost);
-    if (o.thin < 0 || o.thin > 4096) throw bad("--thin", "0..4096 cells", o.thin);
-    if (o.threads < 0) throw bad("--threads", ">= 0", o.threads);
-    if (!(o.coalesce <= 1.f)) throw bad("--coalesce", "a share <= 1 (negative: off)", o.coalesce);
-    if (!(o.coalesce_edge > 0.f)) throw bad("--coalesce-edge", "a length > 0 (mm)", o.coalesce_edge);
+        throw bad("structure.other_cost", "a finite value >= 0 (cells)", o.other_cost);
+    if (o.thin < 0 || o.thin > 4096) throw bad("structure.thin", "0..4096 cells", o.thin);
+    if (o.threads < 0) throw bad("threads", ">= 0", o.threads);
+    if (!(o.coalesce <= 1.f))
+        throw bad("structure.coalesce", "a share <= 1 (negative: off)", o.coalesce);
+    if (!(o.coalesce_edge > 0.f))
+        throw bad("structure.coalesce_edge", "a length > 0 (mm)", o.coalesce_edge);
 }
 
 std::string to_string(const BoxesOptions& o) {

@@ -67,7 +67,7 @@ struct BoxesOptions {
     float coalesce_edge = 64.f;
     int threads = 0;              // 0 = all
 };
-// Throws lacuna::Error naming the CLI option ("--spread", ...) for a bad value.
+// Throws lacuna::FrameError naming the field ("structure.spread", ...) for a bad value.
 void validate(const BoxesOptions& o);
 std::string to_string(const BoxesOptions& o);
 

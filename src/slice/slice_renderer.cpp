@@ -252,15 +252,15 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
     const Camera cam = to_volume_frame(volume_frame(m_volume), world_cam);
     if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
-        throw Error("--step", "step", "expected a positive number");
+        throw FrameError("sampling.step", "expected a positive number");
     if (cam.width() < 1 || cam.height() < 1)
-        throw Error("--size", "image size", "expected at least 1x1 pixels");
+        throw FrameError("width", "expected at least 1x1 pixels");
     const OcclusionOptions& oo = opt.occlusion;
     if (oo.mode != OcclusionMode::Off) {
         if (!(oo.threshold > 0.f && oo.threshold <= 1.f))
-            throw Error("--occlusion-threshold", "threshold", "expected 0 < T <= 1");
+            throw FrameError("slicer.occlusion_threshold", "expected 0 < T <= 1");
         if (oo.map_size < 1 || oo.map_size > 4096)
-            throw Error("--occlusion-map", "map size", "expected 1..4096");
+            throw FrameError("slicer.occlusion_map", "expected 1..4096 cells");
         if (oo.updates < 0) throw Error("occlusion", "updates", "expected >= 0");
     }
     const auto t_start = Clock::now();
@@ -338,7 +338,7 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
     const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
     const ValueToLut vmap = m_lut.map();
     std::atomic<uint64_t> samples{0};
-    const float ert = opt.ert >= 1.f ? 2.f : opt.ert;
+    const float ert = opt.ert >= 1.f ? kNoEarlyTermination : opt.ert;
 
     // 4. Batches of boxes between map updates (one batch without occlusion).
     double rendered = 0, next_update = delta_voxels;

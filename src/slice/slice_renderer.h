@@ -28,6 +28,7 @@
 
 #include "lacuna/camera.h"
 #include "lacuna/image.h"
+#include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
 #include "slice/box_source.h"
@@ -37,7 +38,7 @@ namespace lacuna {
 
 struct SliceOptions {
     float step = 0.5f;  // plane distance in units of the smallest voxel spacing
-    float ert = 2.f;    // per-pixel early termination opacity (>= 1: off, as on the paper's GPU)
+    float ert = kNoEarlyTermination;  // per-pixel early termination opacity (>= 1: off, as on the paper's GPU)
     int threads = 0;    // 0 = all hardware threads
     Vec3f background{0, 0, 0};
     bool keep_float = false;  // fill SliceResult::rgba_float

@@ -198,7 +198,7 @@ TransferFunction resolve_transfer_function(const std::string& spec) {
     if (json_name || std::filesystem::is_regular_file(spec, ec))
         return load_transfer_function(spec);
     throw Error(
-        "--tf", "preset",
+        "tf", "preset",
         "unknown preset '" + spec + "'; expected one of: " + joined_names() + " or a .json file (or slicer:FILE.xml#NAME, FILE.vp, FILE.vp.json)");
 }
 

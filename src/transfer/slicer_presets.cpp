@@ -536,7 +536,7 @@ SlicerVolumeProperty resolve_slicer_preset(const std::string& spec) {
     const std::optional<std::string> name =
         hash == std::string::npos ? std::nullopt : std::optional<std::string>(s.substr(hash + 1));
     if (file.empty())
-        throw Error("--tf", "slicer", "expected slicer:FILE.xml#NAME, FILE.vp or FILE.vp.json");
+        throw Error("tf", "slicer", "expected slicer:FILE.xml#NAME, FILE.vp or FILE.vp.json");
     const std::vector<SlicerVolumeProperty> all = load_slicer_file(file);
     std::string names;
     for (const auto& p : all) names += (names.empty() ? "" : ", ") + p.name;

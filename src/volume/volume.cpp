@@ -163,7 +163,7 @@ void Volume::compute_range(const std::string& where) {
 }
 
 void Volume::set_vis_range(ValueRange r) {
-    check_lut_range(r, kDefaultLutSize, "--range", "visualization range");
+    check_lut_range(r, kDefaultLutSize, "volume", "vis_range");
     m_vis_range = r;
     m_vis_set = true;
 }

@@ -634,7 +634,7 @@ TEST(KdTreeRegion, DeepTreesAndMLimitedListsRenderExactly) {
         RenderOptions ro;
         ro.keep_float = true;
         ro.step = 0.3f + rng.uniform();
-        ro.ert = rng.coin() ? 0.99f : 2.f;
+        ro.ert = rng.coin() ? 0.99f : kNoEarlyTermination;
         const RenderResult ref = m.render(cam, ro);
         m.set_accel(tree.get());
         const RenderResult got = m.render(cam, ro);
@@ -740,27 +740,28 @@ TEST(KdTreeOptions, InvalidOptionsAreOneLineErrorsNamingTheOption) {
         } catch (const Error& e) {
             const std::string msg = e.what();
             EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+            EXPECT_EQ(msg.find("--"), std::string::npos) << msg;  // a field, not a flag
             EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
         }
     };
     AccelOptions o;
     o.kd_max_boxes = -1;
-    expect_error(o, "--max-boxes");
+    expect_error(o, "structure.max_boxes");
     o = {};
     o.kd_delta = -2;
-    expect_error(o, "--delta");
+    expect_error(o, "structure.delta");
     o = {};
     o.kd_min_volume = 1.5f;
-    expect_error(o, "--min-volume");
+    expect_error(o, "structure.min_volume");
     o = {};
     o.kd_min_gain = -0.1f;
-    expect_error(o, "--min-gain");
+    expect_error(o, "structure.min_gain");
     o = {};
     o.kd_max_depth = 65;
-    expect_error(o, "--max-depth");
+    expect_error(o, "structure.max_depth");
     o = {};
     o.kd_threshold = 10.f;
-    expect_error(o, "--threshold");
+    expect_error(o, "structure.threshold");
     EXPECT_EQ(parse_accel("kdtree"), AccelKind::KdTree);
     EXPECT_EQ(to_string(AccelKind::KdTree), "kdtree");
 }

@@ -207,7 +207,7 @@ TEST(FeatureConformance, EveryOptionIsExactForEveryStructure) {
             ao.distance_block = rng.range(1, 4);
             RenderOptions ro;
             ro.step = 0.2f + 1.2f * rng.uniform();
-            ro.ert = rng.coin() ? 0.95f : 2.f;
+            ro.ert = rng.coin() ? 0.95f : kNoEarlyTermination;
             fc.set(ro.features, v, rng);
             const Camera cam = test::random_camera(v, rng, 20);
             expect_exact(std::string(fc.name) + " trial " + std::to_string(trial), v, front,
@@ -239,7 +239,7 @@ TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
             o.keep_float = true;
             o.count_samples = true;
             o.step = 0.2f + 1.2f * rng.uniform();
-            o.ert = trial == 2 ? 2.f : 0.8f + 0.19f * rng.uniform();
+            o.ert = trial == 2 ? kNoEarlyTermination : 0.8f + 0.19f * rng.uniform();
             o.tile = rng.range(3, 17);
             fc.set(o.features, v, rng);
             if (fc.two_tfs && !back) o.features.clip_planes.push_back(random_plane(v, rng));
@@ -300,7 +300,7 @@ TEST(FeatureConformance, ShadedLeapingLanesAreExactOnSparseVolumes) {
         RenderOptions o;
         o.keep_float = true;
         o.step = 0.2f + 1.2f * rng.uniform();
-        o.ert = trial % 2 ? 2.f : 0.8f + 0.19f * rng.uniform();
+        o.ert = trial % 2 ? kNoEarlyTermination : 0.8f + 0.19f * rng.uniform();
         o.features.shading = ShadingModel::Phong;
         o.features.light.kind = trial % 4 < 2 ? LightKind::Head : LightKind::Directional;
         o.features.light.direction = {rng.uniform() - 0.5f, rng.uniform() - 0.5f, 0.5f};
@@ -337,7 +337,7 @@ TEST(FeatureConformance, AcceleratedShadowRaysEqualUnacceleratedOnes) {
         const TransferLut lut = test::random_lut(v.vis_range(), rng);
         RenderOptions ro;
         ro.keep_float = true;
-        ro.ert = trial % 2 ? 0.9f : 2.f;
+        ro.ert = trial % 2 ? 0.9f : kNoEarlyTermination;
         ro.features.shading = ShadingModel::Phong;
         ro.features.light = random_light(v, rng, trial % 3 == 0 ? LightKind::Spot : LightKind::Directional);
         ro.features.shadows.enabled = true;

@@ -80,7 +80,7 @@ TEST(Nearest, EveryKernelPathMarchesTheNearestVoxel) {
         o.interpolation = Interpolation::Nearest;
         o.keep_float = true;
         o.step = 0.2f + rng.uniform();
-        o.ert = trial % 3 ? 2.f : 0.9f;
+        o.ert = trial % 3 ? kNoEarlyTermination : 0.9f;
         const Camera cam = test::random_camera(v, rng, 23);
         const std::vector<float> ref = brute_force_nearest(v, lut, cam, o);
         RayMarcher m(v);
@@ -113,7 +113,7 @@ TEST(Nearest, EveryStructureAndKernelPathIsExact) {
         o.keep_float = true;
         o.count_samples = true;
         o.step = 0.1f + 1.2f * rng.uniform();
-        o.ert = trial % 2 ? 0.85f : 2.f;
+        o.ert = trial % 2 ? 0.85f : kNoEarlyTermination;
         o.tile = rng.range(3, 17);
         if (trial % 3 == 1) {
             o.features.shading = ShadingModel::Phong;

@@ -86,7 +86,7 @@ void check_volume(const Volume& v, const TransferLut& lut, Rng& rng, const std::
         // The stream over runs with gaps (as skipping leaves them), against one sample at a
         // time over exactly the samples of the runs, with and without early termination.
         for (int variant = 0; variant < 4; ++variant) {
-            const float ert = variant < 2 ? 2.f : 0.3f + 0.6f * rng.uniform();
+            const float ert = variant < 2 ? kNoEarlyTermination : 0.3f + 0.6f * rng.uniform();
             std::vector<std::pair<int, int>> runs;
             for (int k = rng.range(0, 5); k < k_end;) {
                 const int k1 = std::min(k_end, k + rng.range(1, 30));

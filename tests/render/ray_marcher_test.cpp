@@ -46,7 +46,7 @@ TEST(RayMarcher, HomogeneousMediumTransmittanceIsBeerLambert) {
     for (float step : {1.f, 0.5f, 0.25f, 0.4f, 0.8f, 0.32f}) {
         RenderOptions o;
         o.step = step;
-        o.ert = 2.f;
+        o.ert = kNoEarlyTermination;
         o.keep_float = true;
         const RenderResult r = m.render(top_down(m, 8), o);
         const double expected = std::exp(-sigma * length);
@@ -60,7 +60,7 @@ TEST(RayMarcher, HomogeneousMediumTransmittanceIsBeerLambert) {
     for (float step : {0.7f, 0.3f}) {
         RenderOptions o;
         o.step = step;
-        o.ert = 2.f;
+        o.ert = kNoEarlyTermination;
         o.keep_float = true;
         const RenderResult r = m.render(top_down(m, 4), o);
         const double expected = std::exp(-sigma * length);
@@ -174,7 +174,7 @@ TEST(RayMarcher, EarlyRayTerminationErrorIsBoundedByThreshold) {
     m.set_transfer_function(discretise(tf, v.vis_range()));
     const Camera cam = Camera::orbit(m.bounds(), OrbitParams{}, 48, 48);
     RenderOptions full, ert;
-    full.ert = 2.f;
+    full.ert = kNoEarlyTermination;
     full.keep_float = ert.keep_float = true;
     ert.ert = 0.95f;
     const RenderResult a = m.render(cam, full), b = m.render(cam, ert);

@@ -143,7 +143,7 @@ TEST(Segments, OctreeSkippingIsByteIdenticalToMarchingEverySample) {
         if (in) ref.set_transfer_function(lut), fast.set_transfer_function(lut);
         RenderOptions ro;
         ro.keep_float = ro.count_samples = true;
-        ro.ert = rng.coin() ? 0.99f : 2.f;
+        ro.ert = rng.coin() ? 0.99f : kNoEarlyTermination;
         ro.step = 0.25f + rng.uniform();
         const Camera cam = random_camera(lab, rng, 36);
         // Several visibility edits on the same structure: no rebuild between them.
@@ -175,7 +175,7 @@ TEST(Segments, MaskModeIsExactThroughEveryIntensityStructure) {
         seg.set_labels(t);
         RenderOptions ro;
         ro.keep_float = ro.count_samples = true;
-        ro.ert = rng.coin() ? 0.99f : 2.f;
+        ro.ert = rng.coin() ? 0.99f : kNoEarlyTermination;
         const Camera cam = random_camera(inten, rng, 30);
         for (Interpolation interp : {Interpolation::Trilinear, Interpolation::Nearest}) {
             ro.interpolation = interp;
@@ -215,7 +215,7 @@ TEST(Segments, MaskWithEveryLabelVisibleIsTheRayMarcherToTheBit) {
         m.set_transfer_function(lut);
         RenderOptions ro;
         ro.keep_float = true;
-        ro.ert = rng.coin() ? 0.99f : 2.f;
+        ro.ert = rng.coin() ? 0.99f : kNoEarlyTermination;
         const Camera cam = random_camera(inten, rng, 32);
         expect_same(seg.render(cam, ro), m.render(cam, ro), "trial " + std::to_string(trial));
         ro.interpolation = Interpolation::Nearest;
@@ -298,7 +298,7 @@ TEST(Segments, SingleLabelSlabMatchesTheAnalyticTransmittance) {
     for (float step : {0.25f, 0.5f, 1.f}) {
         RenderOptions ro;
         ro.keep_float = ro.count_samples = true;
-        ro.ert = 2.f;
+        ro.ert = kNoEarlyTermination;
         ro.step = step;
         const RenderResult r = seg.render(cam, ro);
         const size_t c = size_t(7) * 15 + 7;

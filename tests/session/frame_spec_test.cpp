@@ -6,7 +6,9 @@
 #include <cmath>
 #include <functional>
 
+#include "lacuna/accel.h"
 #include "lacuna/frame_spec.h"
+#include "lacuna/renderer.h"
 #include "lacuna/session.h"
 #include "lacuna/synthetic.h"
 #include "lacuna/transfer_function.h"
@@ -20,11 +22,17 @@ std::string blamed(const FrameSpec& s) {
         validate(s);
     } catch (const FrameError& e) {
         EXPECT_NE(std::string(e.what()).find(e.field()), std::string::npos) << e.what();
-        if (e.field() != "features")  // validate_features' own text still names flags
-            EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
+        EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
         return e.field();
     }
     return "";
+}
+
+Volume test_volume_small() {
+    SyntheticOptions so;
+    so.dims = {12, 10, 9};
+    so.seed = 5;
+    return generate(SyntheticKind::SphereShells, so);
 }
 
 FrameSpec on(Renderer r, Structure s = structure::None{}) {
@@ -106,7 +114,36 @@ TEST(FrameSpec, EachErrorNamesItsField) {
          "slicer.occlusion_threshold"},
         {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_map = 5000; }, "slicer.occlusion_map"},
         {Renderer::Segments, [](FrameSpec& f) { f.segments.tint = 2.f; }, "segments.tint"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.phong.power = -1.f; }, "features"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.phong.power = -1.f; }, "features.phong"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.pbr.roughness = 0.f; }, "features.pbr"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.features.gradient_opacity.enabled = true;
+             f.features.gradient_opacity.lo = 5.f;
+             f.features.gradient_opacity.hi = 1.f;
+         },
+         "features.gradient_opacity"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.light.intensity = -1.f; },
+         "features.light.intensity"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.features.light.kind = LightKind::Directional;
+             f.features.light.direction = {0, 0, 0};
+         },
+         "features.light.direction"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.shadows.step = 0.f; },
+         "features.shadows.step"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.shadows.light_volume_stride = 0; },
+         "features.shadows.light_volume_stride"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) { f.features.clip_planes.push_back({{0, 0, 0}, 1.f}); },
+         "features.clip_planes"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.features.crop = true;
+             f.features.crop_box = {{1, 0, 0}, {0, 1, 1}};
+         },
+         "features.crop_box"},
     };
     for (const auto& [renderer, edit, field] : cases) {
         FrameSpec f = on(renderer);
@@ -146,6 +183,89 @@ TEST(FrameSpec, StructureNamesAndKindsRoundTrip) {
     EXPECT_FALSE(back->bidirectional);
     EXPECT_EQ(back->interpolation, Interpolation::Nearest);
     EXPECT_EQ(back->threads, 3);
+}
+
+// The one parser of structure names (the CLI's --accel, the viewer's accel, Python's structure=):
+// every registry name gives its alternative with default parameters for a renderer that takes it,
+// "auto" each renderer's default, and an unknown name is refused naming every valid one.
+TEST(FrameSpec, ParseStructureIsTheRegistrysNamesForEveryRenderer) {
+    for (const Structure& s : all_structures()) {
+        const std::string name = structure_name(s);
+        bool taken = false;
+        for (const RendererCapabilities& cap : capabilities()) {
+            if (!cap.takes(s)) continue;
+            taken = true;
+            // The segment renderer reads "bitfield" as its label octree.
+            if (cap.renderer == Renderer::Segments && name == "bitfield") continue;
+            EXPECT_EQ(parse_structure(name, cap.renderer), s) << name << " " << to_string(cap.renderer);
+        }
+        EXPECT_TRUE(taken) << name;
+    }
+    EXPECT_EQ(parse_structure("auto", Renderer::RayMarcher), structure_of(default_accel()));
+    EXPECT_EQ(parse_structure("auto", Renderer::Slicer), Structure{structure::None{}});
+    EXPECT_EQ(parse_structure("auto", Renderer::Segments), Structure{structure::LabelOctree{}});
+    EXPECT_EQ(parse_structure("bitfield", Renderer::Segments), Structure{structure::LabelOctree{}});
+    // Parameters travel into the alternative.
+    AccelOptions o;
+    o.leaf_cells = 16;
+    o.bitfield_bits = 128;
+    EXPECT_EQ(parse_structure("bitfield", Renderer::RayMarcher, o),
+              Structure{structure::Bitfield{{16, -1, true}, 128}});
+    EXPECT_EQ(parse_structure("bitfield", Renderer::Segments, o),
+              Structure{structure::LabelOctree{16, 128}});
+    EXPECT_EQ(parse_structure("boxes", Renderer::Slicer, o, {0.5f, 32.f}),
+              Structure{structure::GrowingBoxes{0.5f, 32.f}});
+    for (const char* bad : {"", "octree", "Grid", "none "}) {
+        try {
+            parse_structure(bad, Renderer::RayMarcher);
+            ADD_FAILURE() << "'" << bad << "' was accepted";
+        } catch (const FrameError& e) {
+            EXPECT_EQ(e.field(), "structure");
+            EXPECT_NE(e.expected().find(std::string("'") + bad + "'"), std::string::npos) << e.what();
+            for (const Structure& s : all_structures())
+                EXPECT_NE(e.expected().find(structure_name(s)), std::string::npos) << e.what();
+        }
+    }
+}
+
+// The renderers and structures, called directly (not through validate()), blame the same fields
+// and never a CLI flag.
+TEST(FrameSpec, LibraryErrorsBelowValidateNameFieldsNotFlags) {
+    const Volume vol = test_volume_small();
+    auto field_of = [](const std::function<void()>& f) -> std::string {
+        try {
+            f();
+        } catch (const FrameError& e) {
+            EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
+            return e.field();
+        }
+        return "";
+    };
+    const TransferLut lut = discretise(preset("mr-default"), vol.vis_range());
+    RayMarcher m(vol);
+    m.set_transfer_function(lut);
+    const Camera cam = Camera::orbit(m.bounds(), OrbitParams{}, 8, 8);
+    RenderOptions ro;
+    ro.threads = 1;
+    EXPECT_EQ(field_of([&] { m.render(cam, ro); }), "");
+    RenderOptions bad = ro;
+    bad.step = 0.f;
+    EXPECT_EQ(field_of([&] { m.render(cam, bad); }), "sampling.step");
+    bad = ro;
+    bad.features.shading = ShadingModel::Phong;
+    bad.features.phong.specular = -1.f;
+    EXPECT_EQ(field_of([&] { m.render(cam, bad); }), "features.phong");
+    AccelOptions ao;
+    ao.bitfield_bits = 7;
+    EXPECT_EQ(field_of([&] { make_accel(AccelKind::Bitfield, vol, ao); }), "structure.bits");
+    ao = {};
+    ao.leaf_cells = 3;
+    EXPECT_EQ(field_of([&] { make_accel(AccelKind::MinMax, vol, ao); }), "structure.octree.leaf_cells");
+    ao = {};
+    ao.distance_block = 0;
+    EXPECT_EQ(field_of([&] { make_accel(AccelKind::Chebyshev, vol, ao); }), "structure.block");
+    EXPECT_EQ(field_of([] { parse_accel("octree"); }), "structure");
+    EXPECT_EQ(field_of([] { parse_interpolation("cubic"); }), "sampling.interpolation");
 }
 
 // ---- The table against the renderers ------------------------------------------------------------

@@ -64,7 +64,7 @@ FrameSpec spec(Structure s) {
 RenderOptions options_of(const FrameSpec& f) {
     RenderOptions ro;
     ro.step = f.sampling.step;
-    ro.ert = f.sampling.early_termination.value_or(2.f);
+    ro.ert = f.sampling.early_termination.value_or(kNoEarlyTermination);
     ro.threads = 1;
     ro.features = f.features;
     return ro;

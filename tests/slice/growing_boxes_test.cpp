@@ -151,7 +151,7 @@ TEST(GrowingBoxes, SpreadScalesWithTheVisualizationRange) {
     EXPECT_FLOAT_EQ(BoxMeasure(u, o).spread_limit(), 32.f);  // 32 of 256 for 8-bit data
 }
 
-TEST(GrowingBoxes, BadOptionsNameTheOption) {
+TEST(GrowingBoxes, BadOptionsNameTheirField) {
     auto msg = [](BoxesOptions o) {
         try {
             validate(o);
@@ -162,22 +162,22 @@ TEST(GrowingBoxes, BadOptionsNameTheOption) {
     };
     BoxesOptions o;
     o.spread = -1;
-    EXPECT_NE(msg(o).find("--spread"), std::string::npos);
+    EXPECT_NE(msg(o).find("structure.spread"), std::string::npos);
     o = {};
     o.min_uniform = 0;
-    EXPECT_NE(msg(o).find("--min-box"), std::string::npos);
+    EXPECT_NE(msg(o).find("structure.min_uniform"), std::string::npos);
     o = {};
     o.gradient = NAN;
-    EXPECT_NE(msg(o).find("--gradient"), std::string::npos);
+    EXPECT_NE(msg(o).find("structure.gradient:"), std::string::npos);
     o = {};
     o.gradient_waste = 2;
-    EXPECT_NE(msg(o).find("--gradient-waste"), std::string::npos);
+    EXPECT_NE(msg(o).find("structure.gradient_waste"), std::string::npos);
     o = {};
     o.other_cost = INFINITY;
-    EXPECT_NE(msg(o).find("--other-cost"), std::string::npos);
+    EXPECT_NE(msg(o).find("structure.other_cost"), std::string::npos);
     o = {};
     o.thin = -1;
-    EXPECT_NE(msg(o).find("--thin"), std::string::npos);
+    EXPECT_NE(msg(o).find("structure.thin"), std::string::npos);
 }
 
 // Brute answer for one box: some cell of the box has a built range with a visible entry.

@@ -103,7 +103,7 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
             const Camera cam = random_camera(r, rng, view == 7 ? 23 : 40, view == 5, view == 7 ? 0.3f : 0.f);
             SliceOptions o;
             o.keep_float = true;
-            o.ert = view % 2 ? 0.95f : 2.f;
+            o.ert = view % 2 ? 0.95f : kNoEarlyTermination;
             o.step = view % 3 == 0 ? 0.5f : 0.37f + rng.uniform();
             r.set_box_source(nullptr);
             const SliceResult basic = r.render(cam, o);
@@ -199,7 +199,7 @@ TEST(SliceRenderer, CloseToTheRayMarcher) {
     so2.step = 0.25f;
     RenderOptions ro;
     ro.step = 0.25f;
-    ro.ert = 2.f;
+    ro.ert = kNoEarlyTermination;
     const SliceResult a = s.render(cam, so2);
     const RenderResult b = m.render(cam, ro);
     double sum = 0;
