@@ -75,6 +75,14 @@ std::string flag_of_field(const std::string& field) {
     return flag;
 }
 
+std::string with_flag(const std::string& what) {
+    constexpr std::pair<const char*, const char*> kWheres[] = {
+        {"tf: ", "--tf"}, {"serve: host: ", "--host"}, {"serve: port: ", "--port"}};
+    for (const auto& [prefix, flag] : kWheres)
+        if (what.rfind(prefix, 0) == 0) return std::string(flag) + ": " + what;
+    return what;
+}
+
 void validate_flags(const FrameSpec& spec) {
     try {
         validate(spec);

@@ -11,6 +11,10 @@ namespace lacuna::cli {
 // The `lacuna render` flag that sets FrameSpec field `field` (the longest listed prefix wins:
 // "structure.octree.leaf_cells" -> "--leaf", "structure" -> "--accel").
 std::string flag_of_field(const std::string& field);
+// A library error's line with the flag the user typed in front, for the errors that name their
+// own fields rather than a FrameSpec's ("tf: preset: ..." -> "--tf: tf: preset: ...", the server's
+// "serve: host" -> "--host"); other lines unchanged.
+std::string with_flag(const std::string& what);
 // validate(spec), its FrameError rethrown as lacuna::Error(flag, field, expected).
 void validate_flags(const FrameSpec& spec);
 

@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
                      e.field().c_str(), e.expected().c_str());
         return 2;
     } catch (const lacuna::Error& e) {
-        std::fprintf(stderr, "lacuna: %s\n", e.what());
+        std::fprintf(stderr, "lacuna: %s\n", lacuna::cli::with_flag(e.what()).c_str());
         return 2;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "lacuna: out of memory\n");
