@@ -209,12 +209,12 @@ TEST(FrameSpec, ParseStructureIsTheRegistrysNamesForEveryRenderer) {
     AccelOptions o;
     o.leaf_cells = 16;
     o.bitfield_bits = 128;
-    EXPECT_EQ(parse_structure("bitfield", Renderer::RayMarcher, o),
-              Structure{structure::Bitfield{{16, -1, true}, 128}});
-    EXPECT_EQ(parse_structure("bitfield", Renderer::Segments, o),
-              Structure{structure::LabelOctree{16, 128}});
-    EXPECT_EQ(parse_structure("boxes", Renderer::Slicer, o, {0.5f, 32.f}),
-              Structure{structure::GrowingBoxes{0.5f, 32.f}});
+    const Structure bitfield = structure::Bitfield{{16, -1, true}, 128};
+    const Structure label_octree = structure::LabelOctree{16, 128};
+    const Structure boxes = structure::GrowingBoxes{0.5f, 32.f};
+    EXPECT_EQ(parse_structure("bitfield", Renderer::RayMarcher, o), bitfield);
+    EXPECT_EQ(parse_structure("bitfield", Renderer::Segments, o), label_octree);
+    EXPECT_EQ(parse_structure("boxes", Renderer::Slicer, o, {0.5f, 32.f}), boxes);
     for (const char* bad : {"", "octree", "Grid", "none "}) {
         try {
             parse_structure(bad, Renderer::RayMarcher);
