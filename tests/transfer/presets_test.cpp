@@ -121,7 +121,7 @@ TEST(Presets, ResolvesJsonFiles) {
 
 TEST(Presets, ResolveRejectsUnknownNameWithChoices) {
     const std::string msg = error_message([] { resolve_transfer_function("bone"); });
-    EXPECT_EQ(msg.rfind("--tf: preset: unknown preset 'bone'; expected one of: ", 0), 0u) << msg;
+    EXPECT_EQ(msg.rfind("tf: preset: unknown preset 'bone'; expected one of: ", 0), 0u) << msg;
     EXPECT_NE(msg.find("mr-gap"), std::string::npos) << msg;
     EXPECT_NE(msg.find(".json"), std::string::npos) << msg;
 }
