@@ -24,7 +24,6 @@
 #include "lacuna/image.h"
 #include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
-#include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
 #include "partition_boxes.h"
 #include "partition_frame.h"
@@ -344,11 +343,14 @@ void run(const PartitionArgs& a) {
 
     if (!a.out.empty()) {
         // The picture is rendered with the TF (exactly, skipping with the TF's own kd-tree).
-        // Through a Session, as every front end's frame (it shares the voxels).
-        Session session(vol, a.threads);
-        session.set_transfer_function(tf);
-        frame.structure = structure_of(AccelKind::KdTree, ao);
-        FrameResult r = session.render(frame);
+        AccelOptions render_ao = ao;
+        auto accel = make_accel(AccelKind::KdTree, vol, render_ao);
+        accel->set_transfer_function(lut);
+        marcher.set_transfer_function(lut);
+        marcher.set_accel(accel.get());
+        RenderOptions ro;
+        ro.threads = a.threads;
+        RenderResult r = marcher.render(cam, ro);
         const Projector proj(vcam);
         const int w = a.size >= 384 ? 2 : 1;
         for (size_t i = 0; i < boxes.size(); ++i)
