@@ -1,6 +1,6 @@
 // Camera: perspective or orthographic, placed by orbit parameters around a target.
 // World space is patient RAS in mm (lacuna/orientation.h): +x the patient's right, +y anterior,
-// +z superior. The orbit keeps superior up.
+// +z superior. The orbit keeps superior up unless OrbitParams::up names another direction.
 #pragma once
 #include <string>
 
@@ -19,6 +19,9 @@ struct Ray {
 // looks at the face from the front (the eye on +y, looking toward -y), azimuth 90 from the
 // patient's left, 180 from behind, 270 from the right; elevation lifts the eye toward superior.
 // distance <= 0 means "frame the whole bounds" (the default); zoom > 1 moves closer.
+// `up` is the world direction that points up in the image (projected onto the view plane, so it
+// need only not be parallel to the view direction): superior by default, which becomes anterior
+// when the view looks straight along the superior axis.
 struct OrbitParams {
     float azimuth_deg = 30.f;
     float elevation_deg = 20.f;
@@ -26,6 +29,7 @@ struct OrbitParams {
     float distance = 0.f;
     bool has_target = false;
     Vec3f target{};  // used when has_target; otherwise the centre of the bounds
+    Vec3f up{0, 0, 1};
     float fov_y_deg = 30.f;
     Projection projection = Projection::Perspective;
 };

@@ -185,6 +185,7 @@ struct FrameSpec {
     int width = 512, height = 512;  // 1..16384
     Vec3f background{0, 0, 0};      // linear RGB in [0, 1]
     bool count_samples = false;     // per-pixel sample counts (a heat map)
+    bool keep_float = false;        // FrameResult::rgba_float: the RGBA before 8-bit rounding
 };
 
 // ---- Capabilities -------------------------------------------------------------------------------

@@ -47,6 +47,9 @@ struct SlicerFrameStats {
 struct FrameResult {
     Image image;
     std::vector<uint32_t> sample_counts;  // per pixel, when FrameSpec::count_samples
+    // Per pixel premultiplied RGBA before the background and the 8-bit rounding (the renderer's
+    // values: image = round(clamp(rgb + (1 - a) * background) * 255)), when FrameSpec::keep_float.
+    std::vector<float> rgba_float;
     RenderStats stats;                    // the slicer fills seconds, samples, pixels
     // What this frame did besides rendering.
     double build_seconds = 0;    // built the frame's structure (0: it was built before)

@@ -11,26 +11,67 @@
 The extension (_lacuna) does the work; this file adds the Python-side conveniences: Session,
 Frame, orbit().
 """
+import collections.abc as _abc
 import os as _os
 import tempfile as _tempfile
 
 from ._lacuna import (TransferFunction, Volume, _Session, load, presets, read_png, save_png,
                       structures)
 
-__all__ = ["Volume", "TransferFunction", "Session", "Renderer", "Frame", "load", "presets",
+__all__ = ["Volume", "TransferFunction", "Session", "Renderer", "Frame", "Stats", "load", "presets",
            "structures", "orbit", "render", "save_png", "read_png"]
 
 
+class Stats(_abc.Mapping):
+    """A frame's counters (a read-only mapping, printed as a dict). 'lattice_samples' and the
+    ray marcher's and segment renderer's 'skipped_fraction' (1 - samples / lattice_samples, the
+    viewer's "space skipped") cost a ray set-up per pixel: they are computed when first read, so
+    render() itself does not pay for them."""
+
+    __slots__ = ("_d", "_lattice")
+
+    def __init__(self, d, lattice=None):
+        self._d = d
+        self._lattice = lattice
+
+    def _fill(self):
+        if self._lattice is not None:
+            n = self._lattice()
+            self._lattice = None
+            self._d["lattice_samples"] = n
+            s = self._d["samples"]
+            self._d["skipped_fraction"] = 1.0 - s / n if n and s < n else 0.0
+
+    def __getitem__(self, key):
+        if key not in self._d and key in ("lattice_samples", "skipped_fraction"):
+            self._fill()
+        return self._d[key]
+
+    def __iter__(self):
+        self._fill()
+        return iter(self._d)
+
+    def __len__(self):
+        self._fill()
+        return len(self._d)
+
+    def __repr__(self):
+        return repr(dict(self))
+
+
 class Frame:
-    """One rendered frame: .image (H x W x 4, uint8, or float32 in [0, 1] with dtype='float32'),
-    .stats (a dict), .sample_counts (H x W uint32 with sample_counts=True, else None).
+    """One rendered frame: .image (H x W x 4: uint8, or with dtype='float32' the renderer's
+    premultiplied RGBA before the background and the 8-bit rounding), .image8 (the 8-bit image,
+    the CLI's bytes, whatever the dtype), .stats (a Stats mapping), .sample_counts (H x W uint32
+    with sample_counts=True, else None).
 
     np.asarray(frame) is the image; `image, stats = frame` unpacks; a notebook shows it."""
 
-    __slots__ = ("image", "stats", "sample_counts")
+    __slots__ = ("image", "image8", "stats", "sample_counts")
 
-    def __init__(self, image, stats, sample_counts=None):
+    def __init__(self, image, stats, sample_counts=None, image8=None):
         self.image = image
+        self.image8 = image if image8 is None else image8
         self.stats = stats
         self.sample_counts = sample_counts
 
@@ -45,20 +86,14 @@ class Frame:
     def shape(self):
         return self.image.shape
 
-    def _bytes(self):
-        import numpy as np
-        if self.image.dtype == np.uint8:
-            return self.image
-        return np.rint(np.clip(self.image, 0.0, 1.0) * 255.0).astype(np.uint8)
-
     def save_png(self, path):
         """Writes the image as a PNG (the CLI's writer: the same file for the same pixels)."""
-        save_png(_os.fspath(path), self._bytes())
+        save_png(_os.fspath(path), self.image8)
 
     def _repr_png_(self):
         with _tempfile.TemporaryDirectory() as d:
             path = _os.path.join(d, "frame.png")
-            save_png(path, self._bytes())
+            save_png(path, self.image8)
             with open(path, "rb") as f:
                 return f.read()
 
@@ -126,15 +161,21 @@ class Session:
     def set_labels(self, labels):
         self._s.set_labels(_as_volume(labels))
 
+    def label_table(self, label_style=None):
+        """The label table a segments frame starts from: one dict per label value (label, name,
+        color, opacity, visible), the session's default or label_style (a .json/.lut file or a
+        dict in the JSON format of docs/segments.md) over it."""
+        return self._s.label_table(label_style)
+
     def render(self, **settings):
         """Renders one frame; the keywords are `lacuna render`'s flags (docs/python.md):
         size/width/height, renderer ('march', 'slice', 'segments'), structure ('auto', ...),
-        view or azimuth/elevation (or eye/target), zoom, fov, ortho, pan, step, ert,
+        view or azimuth/elevation (or eye/target), up, zoom, fov, ortho, pan, step, ert,
         interpolation, background, shading, phong, pbr, gradient_volume, gradient_opacity,
         light, light_intensity, shadows, shadow_step, light_volume, clip, crop, blend, jitter,
-        occlusion, segments, label_tint, show, hide, leaf, bits, sample_counts, dtype, refine."""
-        image, stats, counts = self._s.render(**settings)
-        return Frame(image, stats, counts)
+        occlusion, segments, label_tint, label_style, show, hide, leaf, bits, sample_counts, dtype, refine."""
+        image, image8, stats, counts, lattice = self._s.render(**settings)
+        return Frame(image, Stats(stats, lattice), counts, image8)
 
     def orbit(self, n, **settings):
         """Yields n frames around the volume (lacuna.orbit(n)), the other settings fixed."""

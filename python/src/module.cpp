@@ -18,6 +18,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -35,6 +37,7 @@
 #include "lacuna/transfer_function.h"
 #include "lacuna/views.h"
 #include "lacuna/volume.h"
+#include "render/sample_analysis.h"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -58,6 +61,7 @@ constexpr std::pair<const char*, const char*> kKeywords[] = {
     {"height", "height"},
     {"camera.orbit.zoom", "zoom"},
     {"camera.orbit.fov_y_deg", "fov"},
+    {"camera.orbit.up", "up"},
     {"camera.orbit", "azimuth/elevation"},
     {"camera.pan", "pan"},
     {"background", "background"},
@@ -490,6 +494,58 @@ E enum_of(const std::string& s, const char* keyword,
     value_error(keyword, "name", "unknown '" + s + "'; expected one of: " + list);
 }
 
+// The label table a frame starts from (before show/hide): the session's default table, or the
+// CLI's --label-style over it: a .json label table or an MRIcron .lut file, or a dict in the JSON
+// format (docs/segments.md), read by the same parser through a temporary .json file so that its
+// rules and one-line errors are the file's, with "label_style" in place of the file name.
+lacuna::LabelTable label_table_of(PySession& ps, py::object style) {
+    if (style.is_none()) {
+        py::gil_scoped_release nogil;
+        std::lock_guard<std::mutex> lock(ps.mutex);
+        return ps.session->label_table();
+    }
+    auto load = [&](const std::string& path) {
+        py::gil_scoped_release nogil;
+        std::lock_guard<std::mutex> lock(ps.mutex);
+        return lacuna::load_label_table(path, ps.session->label_volume());
+    };
+    if (py::isinstance<py::str>(style) || py::hasattr(style, "__fspath__")) {
+        const std::string path =
+            py::str(py::module_::import("os").attr("fspath")(style)).cast<std::string>();
+        if (!std::filesystem::is_regular_file(path))
+            raise(PyExc_OSError, path + ": file: does not exist");
+        return load(path);
+    }
+    if (!py::isinstance<py::dict>(style))
+        value_error("label_style", "type",
+                    "expected a .json or .lut file or a dict {'labels': [{'label': 1, ...}, ...]}");
+    std::string text;
+    try {
+        text = py::module_::import("json")
+                   .attr("dumps")(style, "allow_nan"_a = false)
+                   .cast<std::string>();
+    } catch (py::error_already_set& e) {
+        value_error("label_style", "labels", std::string("expected JSON values (") + e.what() + ")");
+    }
+    py::module_ tempfile = py::module_::import("tempfile");
+    py::object dir = tempfile.attr("TemporaryDirectory")();
+    const std::string path = py::str(dir.attr("name")).cast<std::string>() + "/label_style.json";
+    try {
+        {
+            std::ofstream out(path, std::ios::binary);
+            out << text;
+        }
+        lacuna::LabelTable t = load(path);
+        dir.attr("cleanup")();
+        return t;
+    } catch (const Error& e) {
+        dir.attr("cleanup")();
+        std::string m = e.what();
+        if (m.rfind(path, 0) == 0) m = "label_style" + m.substr(path.size());
+        raise(PyExc_ValueError, m);
+    }
+}
+
 struct Request {
     lacuna::FrameSpec spec;
     bool refine = true;
@@ -557,6 +613,14 @@ Request request_from(PySession& ps, py::kwargs kwargs) {
         }
     }
     kw.get("target");  // read above when given
+    // The image's up (any camera): superior unless given; validate() refuses one that is not
+    // finite or lies along the view direction.
+    if (kw.has("up")) {
+        const auto u = triple(kw.get("up"), "up", "direction");
+        o.up = {float(u[0]), float(u[1]), float(u[2])};
+    } else {
+        kw.get("up");
+    }
     o.zoom = kw.get<float>("zoom", 1.f);
     o.fov_y_deg = kw.get<float>("fov", 30.f);
     o.projection = kw.get<bool>("ortho", false) ? lacuna::Projection::Orthographic
@@ -659,12 +723,7 @@ Request request_from(PySession& ps, py::kwargs kwargs) {
         f.segments.mode =
             lacuna::parse_segment_mode(kw.get<std::string>("segments", "mask"), "segments");
         f.segments.tint = kw.get<float>("label_tint", 0.f);
-        lacuna::LabelTable table;
-        {
-            py::gil_scoped_release nogil;
-            std::lock_guard<std::mutex> lock(ps.mutex);
-            table = ps.session->label_table();
-        }
+        lacuna::LabelTable table = label_table_of(ps, kw.get("label_style"));
         auto visibility = [&](const char* k, bool visible) {
             py::object o = kw.get(k);
             if (o.is_none()) return;
@@ -681,7 +740,7 @@ Request request_from(PySession& ps, py::kwargs kwargs) {
         visibility("hide", false);
         f.segments.labels = table;
     } else {
-        for (const char* k : {"segments", "label_tint", "show", "hide"})
+        for (const char* k : {"segments", "label_tint", "label_style", "show", "hide"})
             if (kw.has(k))
                 value_error(k, "renderer", "only renderer='segments' takes it");
             else
@@ -697,6 +756,7 @@ Request request_from(PySession& ps, py::kwargs kwargs) {
     if (dtype != "uint8" && dtype != "float32")
         value_error("dtype", "dtype", "expected uint8 or float32, got " + dtype);
     req.float32 = dtype == "float32";
+    f.keep_float = req.float32;  // the renderer's values before the 8-bit rounding
     kw.check_all_read("render");
     try {
         lacuna::validate(f);
@@ -738,9 +798,29 @@ py::array image_array(lacuna::Image&& img) {
                                 bytes->data(), owner);
 }
 
+// The reference count of the "skipped share" (the viewer's figure, src/serve/frame_renderer.cpp):
+// the samples of the lattice march without skipping or early termination for this frame's
+// camera. It costs a ray set-up per pixel, so Frame.stats computes it when first read, not inside
+// render(). The volume copy shares the voxels.
+struct LatticeCount {
+    lacuna::Volume volume;  // the lattice's volume: the label map for the segment renderer
+    lacuna::Camera camera;
+    float step = 0.5f;
+    int threads = 0;
+    uint64_t operator()() const {
+        py::gil_scoped_release nogil;
+        return lacuna::count_lattice_samples(volume, camera, step, threads);
+    }
+};
+
+// (image, image8, stats, sample_counts, lattice): image is the requested dtype (float32: the
+// renderer's premultiplied RGBA before the background and the rounding), image8 the 8-bit image
+// (the CLI's bytes), lattice a callable giving the lattice count (None for the slicer, whose
+// stats carry the Session's own skipped share).
 py::tuple render(PySession& ps, py::kwargs kwargs) {
     const Request req = request_from(ps, std::move(kwargs));
     lacuna::FrameResult r;
+    std::optional<LatticeCount> lattice;
     {
         py::gil_scoped_release nogil;
         std::lock_guard<std::mutex> lock(ps.mutex);
@@ -754,15 +834,30 @@ py::tuple render(PySession& ps, py::kwargs kwargs) {
         r = ps.session->render(req.spec);
         r.build_seconds += built.build_seconds;  // what this call built, before the frame
         r.tf_sync_seconds += built.tf_sync_seconds;
+        if (req.spec.renderer != lacuna::Renderer::Slicer)
+            lattice = LatticeCount{req.spec.renderer == lacuna::Renderer::Segments
+                                       ? ps.session->label_volume()
+                                       : ps.session->volume(),
+                                   ps.session->camera(req.spec), req.spec.sampling.step,
+                                   ps.session->threads()};
     }
     py::dict stats = stats_of(r);
-    py::array image = image_array(std::move(r.image));
-    if (req.float32) image = image.attr("astype")("float32").attr("__truediv__")(255.0f);
+    py::array image8 = image_array(std::move(r.image));
+    py::array image = image8;
+    if (req.float32) {
+        auto* values = new std::vector<float>(std::move(r.rgba_float));
+        py::capsule owner(values, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+        image = py::array_t<float>(
+            {py::ssize_t(req.spec.height), py::ssize_t(req.spec.width), py::ssize_t(4)},
+            values->data(), owner);
+    }
     py::object counts = py::none();
     if (req.spec.count_samples)
         counts = py::array_t<uint32_t>({py::ssize_t(req.spec.height), py::ssize_t(req.spec.width)},
                                        r.sample_counts.data());
-    return py::make_tuple(image, stats, counts);
+    py::object count = py::none();
+    if (lattice) count = py::cpp_function([l = *lattice]() { return l(); });
+    return py::make_tuple(image, image8, stats, counts, count);
 }
 
 void set_tf(PySession& ps, py::handle tf) {
@@ -976,6 +1071,20 @@ opacity=[(x, a), ...], domain='normalized', range=None, name='python').)")
                  std::lock_guard<std::mutex> lock(ps.mutex);
                  ps.session->set_labels(labels.v);
              })
+        .def(
+            "label_table",
+            [](PySession& ps, py::object style) {
+                py::list out;
+                const lacuna::LabelTable t = label_table_of(ps, style);
+                for (int l = 0; l < t.size(); ++l) {
+                    const lacuna::LabelStyle& st = t.styles[size_t(l)];
+                    out.append(py::dict("label"_a = l, "name"_a = st.name,
+                                        "color"_a = py::make_tuple(st.r, st.g, st.b),
+                                        "opacity"_a = st.opacity, "visible"_a = st.visible));
+                }
+                return out;
+            },
+            "label_style"_a = py::none())
         .def("volume",
              [](PySession& ps) {
                  auto v = std::make_shared<PyVolume>();

@@ -335,7 +335,8 @@ def test_float32_stats_sample_counts_and_png(vol, tmp_path):
     s = lacuna.Session(vol, "ct-bone")
     f = s.render(size=40, sample_counts=True)
     g = s.render(size=40, dtype="float32")
-    assert g.image.dtype == np.float32 and np.array_equal(g.image, f.image / np.float32(255))
+    assert g.image.dtype == np.float32 and g.image.shape == (40, 40, 4)
+    assert np.array_equal(g.image8, f.image)  # the 8-bit image comes along
     assert f.sample_counts.shape == (40, 40) and f.sample_counts.sum() == f.stats["samples"]
     assert f.stats["samples_per_ray"] > 0 and f.stats["seconds"] > 0
     image, stats = f
@@ -359,6 +360,86 @@ def test_orbit_gives_evenly_spaced_cameras(vol):
         lacuna.orbit(0)
 
 
+def to_bytes(rgba, background=(0.0, 0.0, 0.0)):
+    """The renderers' write-out (src/render/pixel_driver.cpp) in numpy: float32 rgb + (1 - a) *
+    background, clamped to [0, 1], times 255, rounded half away from zero; alpha 255."""
+    a = rgba[..., 3:4]
+    w = np.float32(1) - a
+    rgb = rgba[..., :3] + w * np.asarray(background, np.float32)
+    x = (np.clip(rgb, np.float32(0), np.float32(1)) * np.float32(255)).astype(np.float64)
+    out = np.full(rgba.shape, 255, np.uint8)
+    out[..., :3] = np.floor(x + 0.5).astype(np.uint8)  # x in [0, 255]: exact in float64
+    return out
+
+
+@pytest.mark.parametrize("settings", [
+    dict(),
+    dict(background=(0.2, 0.3, 0.4), shading="phong", structure="bitfield"),
+    dict(renderer="slice", structure="boxes", background=(0.5, 0.1, 0.9)),
+])
+def test_float32_is_the_renderers_rgba_before_rounding(vol, settings):
+    s = lacuna.Session(vol, "ct-bone")
+    f = s.render(size=40, **settings)
+    g = s.render(size=40, dtype="float32", **settings)
+    assert g.image.dtype == np.float32 and np.array_equal(g.image8, f.image)
+    rgba = g.image
+    # Premultiplied RGBA: opacity in [0, 1], colour <= opacity, partial opacities present
+    # (values an 8-bit image cannot carry), and the 8-bit image follows from it exactly.
+    assert rgba[..., 3].min() >= 0 and rgba[..., 3].max() <= 1.0 + 1e-6
+    assert np.all(rgba[..., :3] <= rgba[..., 3:4] + 1e-5)
+    alpha = rgba[..., 3]
+    assert np.any((alpha > 0.05) & (alpha < 0.95))
+    assert not np.array_equal(rgba, np.round(rgba * 255) / 255)
+    assert np.array_equal(to_bytes(rgba, settings.get("background", (0, 0, 0))), f.image)
+
+
+def test_float32_segments(tmp_path):
+    a = blobs()
+    labels = np.zeros(a.shape, np.uint8)
+    labels[:, :, 16:] = 1
+    s = lacuna.Session(a, "ct-bone", labels=labels)
+    g = s.render(size=40, renderer="segments", dtype="float32", background=(0.1, 0.2, 0.3))
+    assert np.array_equal(to_bytes(g.image, (0.1, 0.2, 0.3)), g.image8)
+    assert g.image[..., 3].max() > 0
+
+
+def test_up_rolls_the_camera_about_the_view_direction(vol):
+    s = lacuna.Session(vol, "ct-bone")
+    base = s.render(size=48, view="anterior")
+    # Superior, the default, in any length: the same bytes.
+    assert np.array_equal(s.render(size=48, view="anterior", up=(0, 0, 2.5)).image, base.image)
+    # Inferior up turns the picture by 180 degrees; +x up (the anterior view's image left,
+    # Camera::orbit's right being -x there) turns it by 90 degrees clockwise: the same rays up
+    # to the float rounding of the pixel grid, so the same picture up to a few rounded bytes.
+    flipped = s.render(size=48, view="anterior", up=(0, 0, -1)).image
+    left_up = s.render(size=48, view="anterior", up=(1, 0, 0)).image
+    for img, turned in ((flipped, np.rot90(base.image, 2)), (left_up, np.rot90(base.image, -1))):
+        assert not np.array_equal(img, base.image)
+        diff = np.abs(img.astype(int) - turned.astype(int))
+        assert diff.mean() < 0.5 and np.mean(diff > 8) < 0.01, (diff.mean(), np.mean(diff > 8))
+    # With an eye and a target as well; and the pan follows the rolled screen axes.
+    t = (15.5, 16.2, 9.2)
+    e = s.render(size=48, eye=(15.5, 16.2 + 100, 9.2), target=t, up=(0, 0, -1)).image
+    e0 = s.render(size=48, eye=(15.5, 16.2 + 100, 9.2), target=t).image
+    assert np.abs(e.astype(int) - np.rot90(e0, 2).astype(int)).mean() < 0.5
+    p = s.render(size=48, view="anterior", up=(0, 0, -1), pan=(0.2, 0.1)).image
+    p0 = s.render(size=48, view="anterior", pan=(-0.2, -0.1)).image
+    assert np.abs(p.astype(int) - np.rot90(p0, 2).astype(int)).mean() < 0.5
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    (dict(view="anterior", up=(0, 1, 0)),
+     r"^up: camera\.orbit\.up: expected a direction not parallel to the view direction$"),
+    (dict(eye=(15, 100, 9), target=(15, 16, 9), up=(0, -3, 0)), r"^up: camera\.orbit\.up: .* not parallel"),
+    (dict(up=(0, float("nan"), 1)), r"^up: camera\.orbit\.up: expected a finite non-zero direction$"),
+    (dict(up=(0, 0, 0)), r"^up: camera\.orbit\.up: expected a finite non-zero direction$"),
+    (dict(up=(0, 1)), r"^up: direction: expected three numbers, got 2$"),
+])
+def test_a_bad_up_raises_one_line(vol, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        lacuna.Session(vol, "ct-bone").render(size=8, **kwargs)
+
+
 def test_eye_and_target_place_the_orbit_camera(vol):
     s = lacuna.Session(vol, "ct-bone")
     # The anterior view's eye (+y of the target) at the distance the orbit would take.
@@ -367,6 +448,80 @@ def test_eye_and_target_place_the_orbit_camera(vol):
     assert a[..., :3].any() and b[..., :3].any()
     c = s.render(size=32, eye=(15.5 + 100, 16.2, 9.2), target=(15.5, 16.2, 9.2)).image
     assert not np.array_equal(b, c)
+
+
+# ---- Skipped share ------------------------------------------------------------------------------
+def test_the_skipped_share_is_measured_against_the_reference_lattice(vol):
+    s = lacuna.Session(vol, "ct-bone")
+    # none without early termination takes every lattice sample: nothing skipped.
+    none = s.render(size=40, structure="none", ert=1).stats
+    assert none["lattice_samples"] == none["samples"] > 0 and none["skipped_fraction"] == 0
+    bit = s.render(size=40, structure="bitfield").stats
+    assert bit["lattice_samples"] == none["lattice_samples"]
+    assert bit["skipped_fraction"] == pytest.approx(1 - bit["samples"] / bit["lattice_samples"])
+    assert 0.3 < bit["skipped_fraction"] < 1, bit["skipped_fraction"]
+    assert "skipped_fraction" in bit and set(dict(bit)) >= {"seconds", "samples", "lattice_samples"}
+    assert "skipped_fraction" in repr(s.render(size=8).stats)
+    # The slicer's share is the Session's own (non-empty voxels its boxes skipped).
+    sl = s.render(size=40, renderer="slice", structure="boxes").stats
+    assert 0 < sl["skipped_fraction"] < 1 and "lattice_samples" not in sl
+    labels = np.zeros(vol.shape, np.uint8)
+    labels[:, :, 16:] = 1
+    seg = lacuna.Session(vol, "ct-bone", labels=labels).render(size=40, renderer="segments").stats
+    assert 0 < seg["skipped_fraction"] < 1 and seg["lattice_samples"] == none["lattice_samples"]
+
+
+# ---- Label styles -------------------------------------------------------------------------------
+def test_label_styles_match_the_cli(tmp_path):
+    a = blobs()
+    labels = np.zeros(a.shape, np.uint8)
+    labels[:, :, :16] = 1
+    labels[:, :, 16:] = 2
+    path, lpath = write_raw(tmp_path, a), write_raw(tmp_path, labels, "labels")
+    style = {"name": "two", "labels": [{"label": 1, "color": [1, 0.2, 0.1], "opacity": 0.5},
+                                       {"label": 2, "name": "right", "color": [0.1, 0.3, 1]}]}
+    jpath = tmp_path / "style.json"
+    jpath.write_text(json.dumps(style))
+    lut = np.zeros(768, np.uint8)
+    lut[1], lut[256 + 2], lut[512 + 1] = 200, 180, 90  # label 1 red-blue, label 2 green
+    lutpath = tmp_path / "labels.lut"
+    lut.tofile(lutpath)
+    s = lacuna.Session(a, "ct-bone", labels=labels)
+    plain = s.render(size=40, renderer="segments", label_tint=0.8).image
+    for spec in (str(jpath), lutpath):
+        out = str(tmp_path / "cli.png")
+        cli("render", path, "--tf", "ct-bone", "--labels", lpath, "--label-style", str(spec),
+            "--label-tint", "0.8", "--hide", "2", "--size", "40", "--out", out)
+        got = s.render(size=40, renderer="segments", label_tint=0.8, label_style=spec, hide=[2])
+        assert np.array_equal(got.image, lacuna.read_png(out)), spec
+        assert not np.array_equal(got.image, plain)
+    # A dict in the JSON format is the file's table.
+    from_dict = s.render(size=40, renderer="segments", label_tint=0.8, label_style=style).image
+    from_file = s.render(size=40, renderer="segments", label_tint=0.8, label_style=jpath).image
+    assert np.array_equal(from_dict, from_file)
+    table = s.label_table(style)
+    assert [t["label"] for t in table] == [0, 1, 2] and not table[0]["visible"]
+    assert table[1]["color"] == pytest.approx((1, 0.2, 0.1)) and table[1]["opacity"] == 0.5
+    assert table[2]["name"] == "right"
+    lut_table = s.label_table(str(lutpath))
+    assert lut_table[1]["color"] == pytest.approx((200 / 255, 0, 90 / 255))
+
+
+@pytest.mark.parametrize("style,error,message", [
+    ({"labels": [{"label": 1, "opacity": 2}]}, ValueError,
+     r"^label_style: labels\[0\]\.opacity: "),
+    ({"labels": [{"label": 1, "colour": [1, 1, 1]}]}, ValueError,
+     r"^label_style: labels\[0\]\.colour: unknown key"),
+    ({"label": []}, ValueError, r"^label_style: labels: expected an object"),
+    ("/nonexistent/style.json", OSError, r"^/nonexistent/style\.json: file: does not exist$"),
+    (3, ValueError, r"^label_style: type: expected a \.json or \.lut file"),
+])
+def test_bad_label_styles_raise_one_line(style, error, message):
+    a = blobs()
+    s = lacuna.Session(a, "ct-bone", labels=(a > 100).astype(np.uint8))
+    with pytest.raises(error, match=message):
+        s.render(size=8, renderer="segments", label_style=style)
+    assert s.render(size=8, renderer="segments").image.shape == (8, 8, 4)
 
 
 # ---- Errors ------------------------------------------------------------------------------------

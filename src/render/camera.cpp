@@ -33,8 +33,10 @@ Camera Camera::orbit(const Box3f& bounds, const OrbitParams& p, int width, int h
     }
     c.m_eye = target + to_eye * dist;
     c.m_forward = -to_eye;
-    Vec3f world_up{0, 0, 1};
-    if (std::abs(dot(world_up, c.m_forward)) > 0.999f) world_up = {0, 1, 0};
+    // The image's up: p.up projected onto the view plane (validate() refuses one parallel to
+    // the view; the superior default falls back to anterior when the view looks along it).
+    Vec3f world_up = p.up;
+    if (std::abs(dot(normalize(world_up), c.m_forward)) > 0.999f) world_up = {0, 1, 0};
     c.m_right = normalize(cross(c.m_forward, world_up));
     c.m_up = cross(c.m_right, c.m_forward);
     return c;

@@ -254,6 +254,16 @@ void validate(const FrameSpec& s) {
     if (!finite(o.azimuth_deg) || !finite(o.elevation_deg))
         fail("camera.orbit", "expected finite azimuth and elevation degrees");
     if (!finite(s.camera.pan_x) || !finite(s.camera.pan_y)) fail("camera.pan", "expected finite numbers");
+    if (o.up != Vec3f{0, 0, 1}) {  // the superior default has its own fallback (Camera::orbit)
+        const float n = length(o.up);
+        if (!finite(o.up.x) || !finite(o.up.y) || !finite(o.up.z) || !(n > 0.f) || !finite(n))
+            fail("camera.orbit.up", "expected a finite non-zero direction");
+        // Camera::orbit's direction to the eye; up must leave a view plane component.
+        const float az = o.azimuth_deg * float(M_PI) / 180.f, el = o.elevation_deg * float(M_PI) / 180.f;
+        const Vec3f to_eye{-std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
+        if (std::abs(dot(o.up, to_eye)) > 0.999f * n)
+            fail("camera.orbit.up", "expected a direction not parallel to the view direction");
+    }
     for (float c : {s.background.x, s.background.y, s.background.z})
         if (!(c >= 0.f && c <= 1.f)) fail("background", "expected R, G, B in [0, 1]");
     // 2. Sampling.

@@ -110,14 +110,11 @@ Camera Session::camera(const FrameSpec& spec) const {
     const Box3f b = world_bounds(spec.renderer == Renderer::Segments && m_labels ? *m_labels : *m_volume);
     OrbitParams op = spec.camera.orbit;
     if (spec.camera.pan_x != 0.f || spec.camera.pan_y != 0.f) {
-        // Pan moves the orbit's target along the view plane (the camera's right and up, as
-        // Camera::orbit derives them), in units of the bounding sphere's radius.
+        // Pan moves the orbit's target along the view plane (the orbit camera's right and up),
+        // in units of the bounding sphere's radius.
         const Camera base = Camera::orbit(b, op, spec.width, spec.height);
-        const Vec3f f = base.forward();
-        Vec3f world_up{0, 0, 1};
-        if (std::abs(dot(world_up, f)) > 0.999f) world_up = {0, 1, 0};
-        const Vec3f right = normalize(cross(f, world_up));
-        const Vec3f up = cross(right, f);
+        const Vec3f right = base.right();
+        const Vec3f up = base.up();
         const float radius = 0.5f * length(b.extent());
         op.has_target = true;
         op.target = b.center() + right * (spec.camera.pan_x * radius) + up * (spec.camera.pan_y * radius);
@@ -309,6 +306,7 @@ RenderOptions render_options(const FrameSpec& spec, int threads) {
     ro.threads = threads;
     ro.background = spec.background;
     ro.count_samples = spec.count_samples;
+    ro.keep_float = spec.keep_float;
     ro.features = spec.features;
     return ro;
 }
@@ -321,6 +319,7 @@ SliceOptions slice_options(const FrameSpec& spec, int threads) {
     o.threads = threads;
     o.background = spec.background;
     o.nearest = spec.sampling.interpolation == Interpolation::Nearest;
+    o.keep_float = spec.keep_float;
     if (spec.slicer.occlusion) {
         o.occlusion.mode = OcclusionMode::CullClip;
         o.occlusion.threshold = spec.slicer.occlusion_threshold;
@@ -360,6 +359,7 @@ FrameResult Session::render(const FrameSpec& spec) {
         case Renderer::Slicer: {
             SliceResult sr = s.slicer->render(cam, slice_options(spec, m_threads));
             r.image = std::move(sr.image);
+            r.rgba_float = std::move(sr.rgba_float);
             r.stats.seconds = sr.stats.seconds;
             r.stats.cpu_seconds = sr.stats.cpu_seconds;
             r.stats.samples = sr.stats.samples;
@@ -379,6 +379,7 @@ FrameResult Session::render(const FrameSpec& spec) {
     }
     out.image = std::move(r.image);
     out.sample_counts = std::move(r.sample_counts);
+    out.rgba_float = std::move(r.rgba_float);
     out.stats = r.stats;
     return out;
 }
