@@ -40,6 +40,7 @@ import time
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--build", default="build", help="build directory (lacuna, python/)")
+    p.add_argument("--cli", default=None, help="the lacuna CLI (default: BUILD/lacuna)")
     p.add_argument("--volume", default="/usr/share/mricron/templates/ch2.nii.gz")
     p.add_argument("--tf", default="mr-skin")
     p.add_argument("--tf2", default="mr-brain", help="the TF the edit switches to")
@@ -85,7 +86,7 @@ def main():
     import numpy as np
     import lacuna
 
-    cli = os.path.join(build, "lacuna")
+    cli = args.cli or os.path.join(build, "lacuna")
     tmp = tempfile.mkdtemp(prefix="lacuna-pybench-")
     png = os.path.join(tmp, "cli.png")
     vol = lacuna.load(args.volume)
