@@ -66,6 +66,14 @@ TEST(FrameSpec, EachErrorNamesItsField) {
          "camera.orbit.fov_y_deg"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.azimuth_deg = NAN; }, "camera.orbit"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.pan_x = INFINITY; }, "camera.pan"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.up = {0, NAN, 1}; }, "camera.orbit.up"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.up = {0, 0, 0}; }, "camera.orbit.up"},
+        {Renderer::RayMarcher,  // along the view: azimuth 0, elevation 0 looks along -y
+         [](FrameSpec& f) {
+             f.camera.orbit.azimuth_deg = f.camera.orbit.elevation_deg = 0.f;
+             f.camera.orbit.up = {0, -2, 0};
+         },
+         "camera.orbit.up"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.background = {0, 2, 0}; }, "background"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{}; }, "structure"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::LabelOctree{}; }, "structure"},

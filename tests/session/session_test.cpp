@@ -3,6 +3,9 @@
 // up); structures are built once and reused across frames and TF changes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "lacuna/accel.h"
 #include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
@@ -269,6 +272,73 @@ TEST(Session, PanZeroIsTheOrbitCameraAndPanMovesIt) {
     EXPECT_EQ(to_string(session.camera(f)), to_string(orbit));
     f.camera.pan_x = 0.25f;
     EXPECT_NE(to_string(session.camera(f)), to_string(orbit));
+}
+
+// The up vector rolls the camera: its negation turns right and up into their exact negations
+// (cross products of negated vectors), so the image is the default one turned by 180 degrees up
+// to the rounding of the pixel grid's coordinates; a tilted up differs from both.
+TEST(Session, UpRollsTheCameraAndItsNegationTurnsTheImage) {
+    Session session(blobs(), 1);
+    session.set_transfer_function(window(0.3, 0.7));
+    FrameSpec f = spec(structure::None{});
+    const Camera c0 = session.camera(f);
+    const FrameResult a = session.render(f);
+    f.camera.orbit.up = {0, 0, -1};
+    const Camera c1 = session.camera(f);
+    EXPECT_EQ(to_string(c1.eye()), to_string(c0.eye()));
+    EXPECT_EQ(to_string(c1.forward()), to_string(c0.forward()));
+    for (int i = 0; i < 3; ++i) {  // == also takes 0 for -0
+        EXPECT_EQ(c1.right()[i], -c0.right()[i]) << i;
+        EXPECT_EQ(c1.up()[i], -c0.up()[i]) << i;
+    }
+    const FrameResult b = session.render(f);
+    const int w = f.width, h = f.height;
+    long diff = 0, nonzero = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const int p = a.image.pixel(x, y)[c], q = b.image.pixel(w - 1 - x, h - 1 - y)[c];
+                diff += std::abs(p - q);
+                nonzero += p != 0;
+            }
+    EXPECT_GT(nonzero, 40);  // the frame shows something
+    EXPECT_LE(double(diff) / (w * h * 3), 0.05);  // the turned image, up to a lattice rounding
+    f.camera.orbit.up = {1, 0, 1};
+    EXPECT_FALSE(session.render(f).image.rgba == a.image.rgba);
+}
+
+// keep_float hands back each renderer's premultiplied RGBA, from which the 8-bit image is
+// round(clamp(rgb + (1 - a) * background) * 255) channel by channel, over a coloured background.
+TEST(Session, KeepFloatIsTheRgbaTheImageIsRoundedFrom) {
+    Session session(blobs(), 1);
+    session.set_labels(label_blobs());
+    session.set_transfer_function(window(0.2, 0.8));
+    for (const RendererCapabilities& cap : capabilities()) {
+        FrameSpec f = spec(structure::None{});
+        f.renderer = cap.renderer;
+        f.background = {0.25f, 0.5f, 0.75f};
+        const FrameResult plain = session.render(f);
+        EXPECT_TRUE(plain.rgba_float.empty());
+        f.keep_float = true;
+        const FrameResult r = session.render(f);
+        EXPECT_TRUE(r.image.rgba == plain.image.rgba) << to_string(cap.renderer);
+        ASSERT_EQ(r.rgba_float.size(), size_t(f.width) * f.height * 4) << to_string(cap.renderer);
+        int seen = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const float* q = &r.rgba_float[(size_t(y) * f.width + x) * 4];
+                ASSERT_GE(q[3], 0.f);
+                ASSERT_LE(q[3], 1.f);
+                seen += q[3] > 0.f;
+                const float bg[3] = {f.background.x, f.background.y, f.background.z};
+                for (int c = 0; c < 3; ++c) {
+                    const float v = std::clamp(q[c] + (1.f - q[3]) * bg[c], 0.f, 1.f) * 255.f;
+                    ASSERT_EQ(int(r.image.pixel(x, y)[c]), int(std::lround(v)))
+                        << to_string(cap.renderer) << " at " << x << "," << y << " channel " << c;
+                }
+            }
+        EXPECT_GT(seen, 15) << to_string(cap.renderer);
+    }
 }
 
 }  // namespace
