@@ -158,21 +158,6 @@ constexpr Rgb kPalette[] = {{255, 64, 64},  {64, 220, 64},  {80, 140, 255}, {255
 
 // A box of the RAS-order copy in the file's voxel index (cells [lo, hi) are voxels lo..hi), with
 // its world (RAS mm) bounding box.
-nlohmann::json box_json(const CellBox& box, uint64_t non_empty, const Volume& file,
-                        const RasOrder& o) {
-    const CellBox b = to_file_cells(box, o, file.dims());
-    double lo[3], hi[3];
-    world_box(file, b, lo, hi);
-    auto mm = [](double x) { return std::round(x * 1e6) / 1e6 + 0.0; };
-    return {
-        {"lo", {b.lo[0], b.lo[1], b.lo[2]}},
-        {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
-        {"cells", box_volume(b)},
-        {"non_empty_cells", non_empty},
-        {"world",
-         {{"lo", {mm(lo[0]), mm(lo[1]), mm(lo[2])}}, {"hi", {mm(hi[0]), mm(hi[1]), mm(hi[2])}}}}};
-}
-
 double ms(double s) {
     return std::round(s * 1e6) / 1e3;
 }
@@ -334,7 +319,9 @@ void run(const PartitionArgs& a) {
             uint64_t ne = 0;
             for (const KdNode& n : part.nodes())
                 if (std::memcmp(&n.box, &b, sizeof b) == 0) ne = n.non_empty;
-            list.push_back(box_json(b, ne, vol, order));
+            nlohmann::json e = box_json(b, vol, order);
+            e["non_empty_cells"] = ne;
+            list.push_back(e);
         }
         j["boxes"] = list;
         io::write_text_atomic(a.json, j.dump(2) + "\n");

@@ -115,20 +115,6 @@ Image figure2(const Volume& vol, const GrowingBoxesSource& src, int k, int size)
     return img;
 }
 
-// A box of the RAS-order copy in the file's voxel index coordinates, with its world box.
-nlohmann::json box_json(const CellBox& box, const Volume& file, const RasOrder& o) {
-    const CellBox b = to_file_cells(box, o, file.dims());
-    double lo[3], hi[3];
-    world_box(file, b, lo, hi);
-    auto mm = [](double x) { return std::round(x * 1e6) / 1e6 + 0.0; };
-    return {
-        {"lo", {b.lo[0], b.lo[1], b.lo[2]}},
-        {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
-        {"cells", box_volume(b)},
-        {"world",
-         {{"lo", {mm(lo[0]), mm(lo[1]), mm(lo[2])}}, {"hi", {mm(hi[0]), mm(hi[1]), mm(hi[2])}}}}};
-}
-
 }  // namespace
 
 void run_partition_boxes(const PartitionBoxesArgs& a, const Volume& file) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "accel/summed_volume_table.h"
 #include "lacuna/orientation.h"
 
 namespace lacuna::cli {
@@ -113,6 +114,19 @@ std::string to_string(const RasOrder& o) {
              "ijk"[o.axis[size_t(a)]];
     }
     return s;
+}
+
+nlohmann::json box_json(const CellBox& box, const Volume& file, const RasOrder& o) {
+    const CellBox b = to_file_cells(box, o, file.dims());
+    double lo[3], hi[3];
+    world_box(file, b, lo, hi);
+    auto mm = [](double x) { return std::round(x * 1e6) / 1e6 + 0.0; };
+    return {
+        {"lo", {b.lo[0], b.lo[1], b.lo[2]}},
+        {"hi", {b.hi[0], b.hi[1], b.hi[2]}},
+        {"cells", box_volume(b)},
+        {"world",
+         {{"lo", {mm(lo[0]), mm(lo[1]), mm(lo[2])}}, {"hi", {mm(hi[0]), mm(hi[1]), mm(hi[2])}}}}};
 }
 
 }  // namespace lacuna::cli

@@ -20,6 +20,8 @@
 #include <array>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "accel/region.h"
 #include "lacuna/math.h"
 #include "lacuna/volume.h"
@@ -51,6 +53,10 @@ Vec3f to_file_index(Vec3f p, const RasOrder& o, Vec3i file_dims);
 // The world (patient RAS, mm) bounding box of the voxels lo..hi of cell box `b` of `v`: the box
 // itself when v's axes are the world's, else the box around its eight corners.
 void world_box(const Volume& v, const CellBox& b, double lo[3], double hi[3]);
+
+// A box of the RAS-order copy in partition's JSON: the file's voxels lo..hi, its cell count and
+// its world box (mm, rounded to 1e-6 so the same anatomy prints the same numbers).
+nlohmann::json box_json(const CellBox& box, const Volume& file, const RasOrder& o);
 
 // The JSON description of the reordering ("ras_order" in partition's JSON).
 std::string to_string(const RasOrder& o);
