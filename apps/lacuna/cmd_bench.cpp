@@ -35,6 +35,7 @@ struct FaludiArgs {
     float step = 0.5f, ert = 0.99f;
     int tf_repeats = 3;
     bool no_ideal = false;
+    bool no_refine = false;
     bool size_given = false, views_given = false;
     std::string rows = "marching,early-exit";  // --rows: also shading, lighting
     float shadow_step = 1.f;
@@ -84,6 +85,7 @@ void run_table(const FaludiArgs& a, const bench::OrbitSpec& orbit, const AccelOp
     fo.threads = a.threads;
     fo.tf_repeats = a.tf_repeats;
     fo.ideal = !a.no_ideal;
+    fo.refine = !a.no_refine;
     fo.modes.clear();
     for (const std::string& n : split_list(a.rows)) fo.modes.push_back(bench::parse_row_mode(n));
     if (!(a.shadow_step > 0.f && a.shadow_step <= 64.f))
@@ -247,6 +249,9 @@ void register_bench(CLI::App& app) {
     f->add_option("--tf-repeats", a->tf_repeats, "TF changes timed per structure (median)")
         ->capture_default_str();
     f->add_flag("--no-ideal", a->no_ideal, "Skip the ideal-speedup sample count");
+    f->add_flag("--no-refine", a->no_refine,
+                "Time each structure without its finer per-TF level (Accel::refine), as right "
+                "after a TF edit");
     f->add_option("--rows", a->rows,
                   "Comma-separated rows: marching, early-exit, shading (+ PBR shading), lighting "
                   "(+ spotlight with shadow rays)")

@@ -42,6 +42,9 @@ struct FaludiOptions {
     int threads = 0;     // render and build threads (0 = all)
     int tf_repeats = 3;  // TF changes timed per structure (the median is reported)
     bool ideal = true;   // count visible-cell samples (the ideal speedup)
+    // Each structure computes its finer per-TF level after the TF change (Accel::refine), as the
+    // CLI's and the viewer's frames do; false times the structures as they are right after an edit.
+    bool refine = true;
     float shadow_step = 1.f;  // '+ Lighting': shadow-ray sample distance (smallest spacings)
     // Every row samples this way, every structure is built for it (AccelOptions::interpolation);
     // under Nearest the ideal counts samples whose own voxel is visible.
@@ -80,6 +83,7 @@ struct StructureResult {
     double generation_ms = 0;  // wall time of make_accel + the first set_transfer_function
     double build_ms = 0;       // AccelStats::build_seconds after the first TF
     double tf_change_ms = 0;   // median of AccelStats::tf_update_seconds over tf_repeats changes
+    double refine_ms = 0;      // AccelStats::refine_seconds (0: not refined, or nothing to refine)
     size_t bytes = 0, nodes = 0;
 };
 

@@ -77,6 +77,25 @@ TEST(BenchFaludi, TinyRunIsExactAndSpeedupsMatchSampleCounts) {
         EXPECT_LE(d.rows[1].ideal_samples, d.rows[0].ideal_samples);
         for (const StructureResult& s : d.structures)
             if (s.kind != AccelKind::None) EXPECT_GT(s.bytes, 0u) << to_string(s.kind);
+        // The grid was refined (its finer per-TF level is what the frames used).
+        EXPECT_GT(d.find(AccelKind::Grid)->refine_ms, 0.0) << d.name;
+    }
+}
+
+// Without refine() the structures are timed as right after an edit: the same exact images,
+// no refine time, and the grid takes at least the samples of its refined self.
+TEST(BenchFaludi, NoRefineIsExactAndRefiningNeverAddsSamples) {
+    FaludiOptions o = tiny_options();
+    o.accels = {AccelKind::Grid};
+    const FaludiReport refined = run_faludi(tiny_datasets(), o);
+    o.refine = false;
+    const FaludiReport plain = run_faludi(tiny_datasets(), o);
+    EXPECT_TRUE(plain.exactness_failures().empty());
+    for (size_t i = 0; i < plain.datasets.size(); ++i) {
+        EXPECT_EQ(plain.datasets[i].find(AccelKind::Grid)->refine_ms, 0.0);
+        for (size_t r = 0; r < plain.datasets[i].rows.size(); ++r)
+            EXPECT_GE(plain.datasets[i].rows[r].find(AccelKind::Grid)->samples,
+                      refined.datasets[i].rows[r].find(AccelKind::Grid)->samples);
     }
 }
 
@@ -110,13 +129,18 @@ TEST(BenchFaludi, TargetsNeedTheirRows) {
     o.modes = {RowMode::MarchingOnly};
     const FaludiReport rep = run_faludi(tiny_datasets(), o);
     const auto targets = check_targets(rep);
-    ASSERT_EQ(targets.size(), 8u);
+    ASSERT_EQ(targets.size(), 9u);
+    EXPECT_NE(targets[0].target.find("default structure (" + to_string(default_accel()) + ")"),
+              std::string::npos)
+        << targets[0].target;
     // No >= 512^3 volume in the tiny run: those targets are not measured, never "met".
-    EXPECT_EQ(targets[1].status, TargetStatus::NotMeasured);
-    EXPECT_EQ(targets[4].status, TargetStatus::NotMeasured);
-    // TF change and share of ideal are measured on any run.
+    EXPECT_EQ(targets[2].status, TargetStatus::NotMeasured);
+    EXPECT_EQ(targets[5].status, TargetStatus::NotMeasured);
+    // The default structure's share, bitfield's share of ideal and TF change are measured on
+    // any run.
     EXPECT_NE(targets[0].status, TargetStatus::NotMeasured);
-    EXPECT_NE(targets[5].status, TargetStatus::NotMeasured);
+    EXPECT_NE(targets[1].status, TargetStatus::NotMeasured);
+    EXPECT_NE(targets[6].status, TargetStatus::NotMeasured);
 }
 
 TEST(BenchFaludi, ColumnsAlwaysStartWithNone) {
