@@ -626,8 +626,10 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
 
 // Trilinear values at sixteen index-space points already clamped into [0, hi] (trilinear8's
 // operations in its order); lanes outside `live` read voxel 0's cell, their values unused. G has
-// cell[3], sy, sz.
-template <class T, class G>
+// cell[3], sy, sz. kSparse (integer voxels): only the `live` lanes load their corners, one by
+// one (the others see corners of 0): the leaping kernels, where most lanes leap in empty space
+// on most steps and a step's loads would otherwise cost as much as sixteen samples.
+template <class T, class G, bool kSparse = false>
 LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& g, const T* data,
                                                                       __m512 x, __m512 y, __m512 z,
                                                                       __mmask16 live) {
@@ -646,15 +648,28 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
         // Corner pairs by 16-bit scalar loads into a table (trilinear8's way; cheaper than
         // four sixteen-lane gathers here), widened: low byte voxel i, high byte voxel i + 1.
         alignas(64) int32_t ofs[16];
-        alignas(32) uint16_t wp[4][16];
+        alignas(64) uint16_t wp[4][16];
         _mm512_store_si512(ofs, off);
         const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-        for (int l = 0; l < 16; ++l) {
-            const T* p = data + ofs[l];
-            __builtin_memcpy(&wp[0][l], p, 2);
-            __builtin_memcpy(&wp[1][l], p + psy, 2);
-            __builtin_memcpy(&wp[2][l], p + psz, 2);
-            __builtin_memcpy(&wp[3][l], p + psyz, 2);
+        if constexpr (kSparse) {
+            _mm512_store_si512(wp[0], _mm512_setzero_si512());
+            _mm512_store_si512(wp[2], _mm512_setzero_si512());
+            for (unsigned mk = live; mk; mk &= mk - 1) {
+                const int l = __builtin_ctz(mk);
+                const T* p = data + ofs[l];
+                __builtin_memcpy(&wp[0][l], p, 2);
+                __builtin_memcpy(&wp[1][l], p + psy, 2);
+                __builtin_memcpy(&wp[2][l], p + psz, 2);
+                __builtin_memcpy(&wp[3][l], p + psyz, 2);
+            }
+        } else {
+            for (int l = 0; l < 16; ++l) {
+                const T* p = data + ofs[l];
+                __builtin_memcpy(&wp[0][l], p, 2);
+                __builtin_memcpy(&wp[1][l], p + psy, 2);
+                __builtin_memcpy(&wp[2][l], p + psz, 2);
+                __builtin_memcpy(&wp[3][l], p + psyz, 2);
+            }
         }
         const __m512i m = _mm512_set1_epi32(0xff);
         const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
@@ -675,12 +690,24 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
         alignas(64) int32_t wq[4][16];
         _mm512_store_si512(ofs, off);
         const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-        for (int l = 0; l < 16; ++l) {
-            const T* p = data + ofs[l];
-            __builtin_memcpy(&wq[0][l], p, 4);
-            __builtin_memcpy(&wq[1][l], p + psy, 4);
-            __builtin_memcpy(&wq[2][l], p + psz, 4);
-            __builtin_memcpy(&wq[3][l], p + psyz, 4);
+        if constexpr (kSparse) {
+            for (int i = 0; i < 4; ++i) _mm512_store_si512(wq[i], _mm512_setzero_si512());
+            for (unsigned mk = live; mk; mk &= mk - 1) {
+                const int l = __builtin_ctz(mk);
+                const T* p = data + ofs[l];
+                __builtin_memcpy(&wq[0][l], p, 4);
+                __builtin_memcpy(&wq[1][l], p + psy, 4);
+                __builtin_memcpy(&wq[2][l], p + psz, 4);
+                __builtin_memcpy(&wq[3][l], p + psyz, 4);
+            }
+        } else {
+            for (int l = 0; l < 16; ++l) {
+                const T* p = data + ofs[l];
+                __builtin_memcpy(&wq[0][l], p, 4);
+                __builtin_memcpy(&wq[1][l], p + psy, 4);
+                __builtin_memcpy(&wq[2][l], p + psz, 4);
+                __builtin_memcpy(&wq[3][l], p + psyz, 4);
+            }
         }
         const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
         const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
@@ -837,39 +864,48 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
                 nearest_values<T, 16>(data, ofs, vals);
                 v = _mm512_load_ps(vals);
             }
-        } else {
+        } else if constexpr (!kLeap) {
             v = trilinear16(g, data, x, y, z, active);
         }
-        // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead.
+        // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead; only
+        // the others load their corners.
         __mmask16 taken = valid;
         __m512i adv = ione;
-        if constexpr (kLeap) leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
-        __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
-        u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
-        const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
-        // RGBA of the 16 entries: sixteen 16-byte loads and a 4x4 transpose per 128-bit lane
-        // (gathers cost ~1.4 cycles per element here; this is ~1.5 shuffles per sample). Lane j
-        // of q4[i] holds lane 4j + i's entry, so the transpose leaves the channels in lane order.
-        alignas(64) int32_t e[16];
-        _mm512_store_si512(e, entry);
-        __m512 q4[4];
-        for (int i = 0; i < 4; ++i) {
-            __m512 v = _mm512_castps128_ps512(_mm_loadu_ps(lut + 4 * ptrdiff_t(e[i])));
-            v = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[4 + i])), 1);
-            v = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[8 + i])), 2);
-            q4[i] = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[12 + i])), 3);
+        if constexpr (kLeap) {
+            leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
+            v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(g, data, x, y, z,
+                                                                std::is_integral_v<T> ? taken : active);
         }
-        const __m512 t0 = _mm512_unpacklo_ps(q4[0], q4[1]), t1 = _mm512_unpackhi_ps(q4[0], q4[1]);
-        const __m512 t2 = _mm512_unpacklo_ps(q4[2], q4[3]), t3 = _mm512_unpackhi_ps(q4[2], q4[3]);
-        const __m512 cr = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
-        const __m512 cg = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
-        const __m512 cb = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
-        const __m512 ca = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
-        const __m512 w = _mm512_sub_ps(one, aa);
-        ar = _mm512_add_ps(ar, _mm512_mul_ps(w, cr));
-        ag = _mm512_add_ps(ag, _mm512_mul_ps(w, cg));
-        ab = _mm512_add_ps(ab, _mm512_mul_ps(w, cb));
-        aa = _mm512_add_ps(aa, _mm512_mul_ps(w, ca));
+        // A step on which every lane leaps composites nothing (their entries would be the
+        // zero entry, which adds exact zeros): the LUT loads are skipped.
+        if (!kLeap || taken) {
+            __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
+            u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
+            const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
+            // RGBA of the 16 entries: sixteen 16-byte loads and a 4x4 transpose per 128-bit lane
+            // (gathers cost ~1.4 cycles per element here; this is ~1.5 shuffles per sample). Lane j
+            // of q4[i] holds lane 4j + i's entry, so the transpose leaves the channels in lane order.
+            alignas(64) int32_t e[16];
+            _mm512_store_si512(e, entry);
+            __m512 q4[4];
+            for (int i = 0; i < 4; ++i) {
+                __m512 v = _mm512_castps128_ps512(_mm_loadu_ps(lut + 4 * ptrdiff_t(e[i])));
+                v = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[4 + i])), 1);
+                v = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[8 + i])), 2);
+                q4[i] = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[12 + i])), 3);
+            }
+            const __m512 t0 = _mm512_unpacklo_ps(q4[0], q4[1]), t1 = _mm512_unpackhi_ps(q4[0], q4[1]);
+            const __m512 t2 = _mm512_unpacklo_ps(q4[2], q4[3]), t3 = _mm512_unpackhi_ps(q4[2], q4[3]);
+            const __m512 cr = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
+            const __m512 cg = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
+            const __m512 cb = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
+            const __m512 ca = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
+            const __m512 w = _mm512_sub_ps(one, aa);
+            ar = _mm512_add_ps(ar, _mm512_mul_ps(w, cr));
+            ag = _mm512_add_ps(ag, _mm512_mul_ps(w, cg));
+            ab = _mm512_add_ps(ab, _mm512_mul_ps(w, cb));
+            aa = _mm512_add_ps(aa, _mm512_mul_ps(w, ca));
+        }
         n = _mm512_mask_add_epi32(n, taken, n, ione);
         if constexpr (kLeap)
             k = _mm512_min_epi32(_mm512_mask_add_epi32(k, valid, k, adv), kend);

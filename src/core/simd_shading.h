@@ -818,10 +818,12 @@ LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* da
         const __m512 x = _mm512_max_ps(zero, _mm512_min_ps(vhi0, px));
         const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(vhi1, py));
         const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(vhi2, pz));
-        const __m512 v = trilinear16(g, data, x, y, z, active);
         __mmask16 taken;
         __m512i adv;
         leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        // (only the lanes that take their sample load its corners: trilinear16's kSparse)
+        const __m512 v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
+            g, data, x, y, z, std::is_integral_v<T> ? taken : active);
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
         u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
         const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
