@@ -725,6 +725,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
         const __m256 v = trilinear8(g, data, x, y, z);
         __m256i taken = valid, adv = _mm256_set1_epi32(1);
         if constexpr (kLeap) leap8(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        prefetch_ahead8(g, data, t, ox, oy, oz, dx, dy, dz, taken);  // (simd_lanes.h)
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
         const __m256i entry = _mm256_blendv_epi8(vzero_entry, _mm256_cvttps_epi32(u), taken);
@@ -821,6 +822,7 @@ LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* da
         __mmask16 taken;
         __m512i adv;
         leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);  // (simd_lanes.h)
         // (only the lanes that take their sample load its corners: trilinear16's kSparse)
         const __m512 v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
             g, data, x, y, z, std::is_integral_v<T> ? taken : active);
