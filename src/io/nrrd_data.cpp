@@ -17,6 +17,33 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Every "key: value" field of a NRRD header, in order, to visit(key, value) (both trimmed; comment
+// lines and lines without a colon skipped; at most 10000 lines): the one walk of the three
+// readers below. It stops at the blank line that ends an attached header; `end`, if given,
+// receives whether that line came and the offset of the first byte after it.
+struct HeaderEnd {
+    bool blank_line = false;
+    uint64_t offset = 0;
+};
+template <class Visit>
+void for_each_nrrd_field(const std::string& header, Visit&& visit, HeaderEnd* end = nullptr) {
+    std::ifstream in(header, std::ios::binary);
+    std::string line;
+    HeaderEnd e;
+    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
+        e.offset += line.size() + 1;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) {
+            e.blank_line = true;
+            break;
+        }
+        const size_t colon = line.find(':');
+        if (line[0] == '#' || colon == std::string::npos) continue;
+        visit(trim(line.substr(0, colon)), trim(line.substr(colon + 1)));
+    }
+    if (end) *end = e;
+}
+
 // The header's fields that place the data, and where the header ends in its own file.
 struct NrrdFields {
     std::string encoding = "raw", data_file;
@@ -26,31 +53,23 @@ struct NrrdFields {
 };
 
 NrrdFields parse_fields(const std::string& header) {
-    std::ifstream in(header, std::ios::binary);
     NrrdFields f;
-    std::string line;
-    uint64_t pos = 0;
-    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
-        pos += line.size() + 1;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.empty()) {
-            f.has_blank_line = true;
-            break;
-        }
-        const size_t colon = line.find(':');
-        if (line[0] == '#' || colon == std::string::npos) continue;
-        const std::string key = trim(line.substr(0, colon));
-        const std::string value = trim(line.substr(colon + 1));
-        if (key == "encoding")
-            f.encoding = to_lower(value);
-        else if (key == "data file" || key == "datafile")
-            f.data_file = value;
-        else if (key == "byte skip" || key == "byteskip")
-            f.byte_skip = std::atoll(value.c_str());
-        else if (key == "line skip" || key == "lineskip")
-            f.line_skip = std::atoll(value.c_str());
-    }
-    f.header_end = pos;
+    HeaderEnd end;
+    for_each_nrrd_field(
+        header,
+        [&](const std::string& key, const std::string& value) {
+            if (key == "encoding")
+                f.encoding = to_lower(value);
+            else if (key == "data file" || key == "datafile")
+                f.data_file = value;
+            else if (key == "byte skip" || key == "byteskip")
+                f.byte_skip = std::atoll(value.c_str());
+            else if (key == "line skip" || key == "lineskip")
+                f.line_skip = std::atoll(value.c_str());
+        },
+        &end);
+    f.header_end = end.offset;
+    f.has_blank_line = end.blank_line;
     return f;
 }
 
@@ -112,23 +131,14 @@ bool nrrd_vectors(const std::string& value, std::vector<std::vector<double>>& ou
 }  // namespace
 
 void check_nrrd_geometry(const std::string& header) {
-    std::ifstream in(header, std::ios::binary);
-    std::string line;
-    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.empty()) break;
-        const size_t colon = line.find(':');
-        if (line[0] == '#' || colon == std::string::npos) continue;
-        const std::string key = trim(line.substr(0, colon));
-        if (key != "space directions" && key != "space origin") continue;
-        const std::string value = trim(line.substr(colon + 1));
+    for_each_nrrd_field(header, [&](const std::string& key, const std::string& value) {
+        if (key != "space directions" && key != "space origin") return;
         std::vector<std::vector<double>> vectors;
         bool finite = true;
-        if (!nrrd_vectors(value, vectors, finite)) continue;  // NrrdIO's to judge
+        if (!nrrd_vectors(value, vectors, finite)) return;  // NrrdIO's to judge
         if (!finite)
-            throw Error(header, key,
-                        "expected finite coordinates, got '" + one_line(value, 120) + "'");
-        if (key != "space directions") continue;
+            throw Error(header, key, "expected finite coordinates, got '" + one_line(value, 120) + "'");
+        if (key != "space directions") return;
         for (size_t a = 0; a < vectors.size(); ++a) {
             const std::vector<double>& v = vectors[a];
             if (!v.empty() && std::all_of(v.begin(), v.end(), [](double x) { return x == 0; }))
@@ -137,25 +147,19 @@ void check_nrrd_geometry(const std::string& header) {
                                 " is the zero vector (a zero or singular affine): '" +
                                 one_line(value, 120) + "'");
         }
-    }
+    });
 }
 
 bool apply_nrrd_las_space(const std::string& header, Volume& v) {
-    std::ifstream in(header, std::ios::binary);
-    std::string line, space;
+    std::string space;
     std::vector<std::vector<double>> dirs, origin;
-    bool finite = true;
-    for (int n = 0; n < 10000 && std::getline(in, line); ++n) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.empty()) break;
-        const size_t colon = line.find(':');
-        if (line[0] == '#' || colon == std::string::npos) continue;
-        const std::string key = trim(line.substr(0, colon));
-        const std::string value = trim(line.substr(colon + 1));
+    bool finite = true, parsed = true;
+    for_each_nrrd_field(header, [&](const std::string& key, const std::string& value) {
         if (key == "space") space = to_lower(value);
-        if (key == "space directions" && !nrrd_vectors(value, dirs, finite)) return false;
-        if (key == "space origin" && !nrrd_vectors(value, origin, finite)) return false;
-    }
+        if (key == "space directions" && parsed) parsed = nrrd_vectors(value, dirs, finite);
+        if (key == "space origin" && parsed) parsed = nrrd_vectors(value, origin, finite);
+    });
+    if (!parsed) return false;
     if (space != "left-anterior-superior" && space != "las" &&
         space != "left-anterior-superior-time" && space != "last")
         return false;
