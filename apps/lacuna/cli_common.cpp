@@ -2,8 +2,11 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
+#include <stdexcept>
 
 #include "lacuna/error.h"
 #include "lacuna/views.h"
@@ -24,6 +27,10 @@ void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required) {
                        format_bytes(default_memory_budget()) + " here)");
     cmd.add_flag("--allow-external-data", a.allow_external_data,
                  "Let a detached header (.nhdr, .mhd) name a data file outside its folder");
+    cmd.add_option("--frame", a.frame,
+                   "4D NIfTI files: which volume along the 4th axis (0-based; required when the "
+                   "file holds several)");
+    cmd.add_option("--spacing", a.spacing, "Raw files: voxel spacing X,Y,Z in mm (default 1,1,1)");
 }
 
 uint64_t parse_bytes(const std::string& s, const std::string& where) {
@@ -52,6 +59,30 @@ uint64_t parse_bytes(const std::string& s, const std::string& where) {
         return uint64_t(bytes);
     }
     throw bad();
+}
+
+Vec3d parse_spacing(const std::string& s, const std::string& where) {
+    Vec3d sp{0, 0, 0};
+    std::istringstream in(s);
+    std::string part;
+    int n = 0;
+    while (std::getline(in, part, ',')) {
+        size_t used = 0;
+        double x = 0;
+        try {
+            x = std::stod(part, &used);
+        } catch (const std::logic_error&) {
+            used = 0;
+        }
+        if (n >= 3 || used == 0 || used != part.size() || !std::isfinite(x) || !(x > 0)) {
+            n = -1;
+            break;
+        }
+        sp[n++] = x;
+    }
+    if (n != 3)
+        throw Error(where, "spacing", "expected three positive numbers X,Y,Z in mm, e.g. 0.5,0.5,1, got '" + s + "'");
+    return sp;
 }
 
 Vec3i parse_dims(const std::string& s, const std::string& where) {
@@ -84,6 +115,16 @@ Volume load_volume(const VolumeArgs& a) {
         spec.type = parse_voxel_type(a.raw_type, "--type");
         ro.raw = spec;
     }
+    if (!a.spacing.empty()) {
+        // A raw file's layout comes from --dims/--type or its name; --spacing completes either.
+        if (!ro.raw) ro.raw = raw_spec_from_name(a.path);
+        if (!ro.raw || std::filesystem::path(a.path).extension() != ".raw")
+            throw Error("--spacing", "spacing",
+                        "applies to .raw files (other formats carry their own spacing); for a raw "
+                        "file give --dims and --type or a name like head_181x217x181_uint8.raw");
+        ro.raw->spacing = parse_spacing(a.spacing, "--spacing");
+    }
+    ro.frame = a.frame;
     if (!a.max_memory.empty()) ro.max_memory.bytes = parse_bytes(a.max_memory, "--max-memory");
     ro.max_memory.name = "--max-memory";
     ro.allow_external_data = a.allow_external_data;

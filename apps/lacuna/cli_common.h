@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include "lacuna/camera.h"
@@ -19,6 +20,8 @@ struct VolumeArgs {
     std::string range;     // "MIN:MAX" visualization range override
     std::string max_memory;  // "12G", "512MB", "1.5GiB", bytes; empty: the default budget
     bool allow_external_data = false;
+    std::optional<int64_t> frame;  // --frame: the volume of a 4D NIfTI file
+    std::string spacing;           // --spacing X,Y,Z for .raw files (mm)
 };
 void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required = true);
 // Loads the volume (with a progress line on a terminal) and applies --range.
@@ -31,6 +34,8 @@ uint64_t parse_bytes(const std::string& s, const std::string& where);
 
 // Parses "AxBxC" into dims; throws lacuna::Error(where, "dims", ...).
 Vec3i parse_dims(const std::string& s, const std::string& where);
+// Parses "X,Y,Z" (positive, finite, mm) into a spacing; throws lacuna::Error(where, "spacing", ...).
+Vec3d parse_spacing(const std::string& s, const std::string& where);
 
 // Fails early (before any work) if `path` cannot be created: its folder must exist and be
 // writable, and it must end with `ext`. Throws lacuna::Error(path, "output", ...).

@@ -40,10 +40,14 @@ struct ReadOptions {
     // Detached data files (.nhdr "data file", .mhd ElementDataFile) must be regular files in
     // the header's folder or below it; true also allows any other regular file.
     bool allow_external_data = false;
+    // Which volume of a 4D NIfTI file (0-based, along dim[4]): required when the file holds more
+    // than one, which is otherwise an error naming their count; a 3D file takes only 0. Other
+    // formats are read as one volume and take only 0.
+    std::optional<int64_t> frame;
 };
 
-// Reads a volume: .nii/.nii.gz (NIfTI-1/2), .nrrd/.nhdr, .mha/.mhd, a folder of DICOM slices,
-// or .raw. Voxel types other than uint8/int16/uint16/float32 are converted (int8 -> int16,
+// Reads a volume: .nii/.nii.gz (NIfTI-1/2; of a 4D file the volume ReadOptions::frame),
+// .nrrd/.nhdr, .mha/.mhd, a folder of DICOM slices, or .raw. Voxel types other than uint8/int16/uint16/float32 are converted (int8 -> int16,
 // uint32/int32/float64 -> float32); non-scalar images are rejected. Computes the value range
 // and rejects NaN/Inf. The voxels are read once into the Volume's own buffer (no second
 // full-size copy). Throws lacuna::Error("<path>", "<field>", "<problem>") on any bad input.

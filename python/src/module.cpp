@@ -251,8 +251,9 @@ std::shared_ptr<PyVolume> volume_from_array(py::object obj, py::object spacing, 
 
 std::shared_ptr<PyVolume> load(const std::string& path, py::object dims, py::object dtype,
                                py::object spacing, py::object range, py::object max_memory,
-                               bool allow_external_data) {
+                               bool allow_external_data, py::object frame) {
     lacuna::ReadOptions ro;
+    if (!frame.is_none()) ro.frame = py::cast<int64_t>(frame);
     if (!dims.is_none() || !dtype.is_none()) {
         if (dims.is_none() || dtype.is_none())
             value_error(path, "raw layout", "give both dims and dtype for a raw file");
@@ -965,10 +966,11 @@ Volume(array, spacing=None, affine=None, axes='zyx', range=None)
     m.def(
         "load", &load, "path"_a, "dims"_a = py::none(), "dtype"_a = py::none(),
         "spacing"_a = py::none(), "range"_a = py::none(), "max_memory"_a = py::none(),
-        "allow_external_data"_a = false,
+        "allow_external_data"_a = false, "frame"_a = py::none(),
         R"(Reads a volume file as the CLI does: .nii/.nii.gz, .nrrd/.nhdr, .mha/.mhd, a DICOM folder,
-or .raw (dims=(x, y, z) and dtype, or a name like head_256x256x128_uint8.raw). Raises OSError
-with the reader's one-line message.)");
+or .raw (dims=(x, y, z) and dtype, or a name like head_256x256x128_uint8.raw). frame=N picks the
+volume of a 4D NIfTI file (required when it holds several). Raises OSError with the reader's
+one-line message.)");
 
     py::class_<PyTf>(m, "TransferFunction", R"(A transfer function.
 

@@ -207,6 +207,20 @@ def test_load_reads_what_the_cli_reads(tmp_path):
         lacuna.load(str(tmp_path / "x.raw"), dims=(2, 2, 2))
 
 
+def test_load_picks_a_volume_of_a_4d_nifti(tmp_path):
+    nib = pytest.importorskip("nibabel")
+    series = np.stack([blobs(dtype=np.uint8).T + 10 * t for t in range(3)], axis=-1)  # (x, y, z, t)
+    path = str(tmp_path / "series.nii.gz")
+    nib.save(nib.Nifti1Image(series, np.diag([0.5, 1.0, 2.0, 1.0])), path)
+    for t in range(3):
+        v = lacuna.load(path, frame=t)
+        assert np.array_equal(v.array, series[..., t].T) and v.spacing == (0.5, 1.0, 2.0)
+    with pytest.raises(OSError, match=r"frame: the file holds 3 volumes along dim\[4\]; choose one \(0\.\.2\)"):
+        lacuna.load(path)
+    with pytest.raises(OSError, match=r"frame: expected 0\.\.2, got 3"):
+        lacuna.load(path, frame=3)
+
+
 # ---- Transfer functions --------------------------------------------------------------------------
 def test_transfer_functions_from_presets_files_and_points(tmp_path):
     assert "mr-brain" in lacuna.presets()

@@ -28,6 +28,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -220,14 +221,26 @@ DiskType disk_type_from(int datatype, const std::string& path) {
     }
 }
 
-Vec3i checked_dims(const NiftiHeader& h, const std::string& path) {
+// The grid of one volume, and how many volumes the file holds along dim[4] (time, or any 4th
+// axis: fMRI runs, diffusion directions, several echoes). Axes 5..7 must be 1: components (dim[5])
+// are not volumes to choose from.
+struct NiftiGrid {
+    Vec3i dims;
+    int64_t frames = 1;
+};
+NiftiGrid checked_dims(const NiftiHeader& h, const std::string& path) {
     const int64_t nd = h.dim[0];
     if (nd < 1 || nd > 7)
         throw Error(path, "header", "dim[0] is " + std::to_string(nd) + ", expected 1..7");
     if (nd < 3)
         throw Error(path, "dims", "expected a 3D volume, got a " + std::to_string(nd) + "D image");
+    int64_t frames = 1;
     for (int i = 4; i <= nd; ++i) {
         if (h.dim[i] == 1) continue;
+        if (i == 4 && h.dim[4] > 1 && h.dim[4] <= (int64_t(1) << 31)) {
+            frames = h.dim[4];
+            continue;
+        }
         if (i == 5)
             throw Error(path, "dims",
                         "expected a scalar image, got " + std::to_string(h.dim[5]) + " components");
@@ -242,7 +255,23 @@ Vec3i checked_dims(const NiftiHeader& h, const std::string& path) {
                             std::to_string(h.dim[1]) + "x" + std::to_string(h.dim[2]) + "x" +
                             std::to_string(h.dim[3]));
     }
-    return {int(h.dim[1]), int(h.dim[2]), int(h.dim[3])};
+    return {{int(h.dim[1]), int(h.dim[2]), int(h.dim[3])}, frames};
+}
+
+// The volume of a file with `frames` volumes that ReadOptions::frame names.
+int64_t chosen_frame(int64_t frames, const std::optional<int64_t>& frame, const std::string& path) {
+    const std::string range = "0.." + std::to_string(frames - 1);
+    if (!frame) {
+        if (frames == 1) return 0;
+        throw Error(path, "frame",
+                    "the file holds " + std::to_string(frames) +
+                        " volumes along dim[4]; choose one (" + range + ")");
+    }
+    if (*frame < 0 || *frame >= frames)
+        throw Error(path, "frame",
+                    "expected " + range + (frames == 1 ? " (the file holds one volume)" : "") +
+                        ", got " + std::to_string(*frame));
+    return *frame;
 }
 
 double positive_or_one(double s) {
@@ -445,15 +474,19 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     if (!f) throw Error(path, "file", std::string("cannot open: ") + std::strerror(errno));
     gzbuffer(f.get(), 1u << 20);
     const NiftiHeader h = parse_header(f.get(), path);
-    const Vec3i dims = checked_dims(h, path);
+    const NiftiGrid grid = checked_dims(h, path);
+    const Vec3i dims = grid.dims;
+    const int64_t frame = chosen_frame(grid.frames, opts.frame, path);
     const DiskType disk = disk_type_from(h.datatype, path);
 
     // NIfTI: slope 0 (or non-finite) means "no scaling"; scaled data is float, as in ITK.
     const bool rescale = std::isfinite(h.slope) && std::isfinite(h.inter) && h.slope != 0.0 &&
                          (h.slope != 1.0 || h.inter != 0.0);
     const VoxelType type = rescale ? VoxelType::Float32 : stored_type(disk);
-    // dims are 2..kMaxDim each, so these products fit; sat_add guards a wild vox_offset.
+    // dims are 2..kMaxDim each, so these products fit; sat_add guards a wild vox_offset. The
+    // chosen volume starts `frame` volumes after vox_offset (frames are stored one after another).
     const uint64_t data_bytes = grid_bytes(dims, disk_type_size(disk));
+    const uint64_t offset = sat_add(uint64_t(h.vox_offset), sat_mul(uint64_t(frame), data_bytes));
     check_budget(path, "dims", dims_string(dims) + " " + to_string(type),
                  grid_bytes(dims, voxel_size(type)), opts.max_memory);
 
@@ -463,22 +496,25 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     if (gzdirect(f.get())) {
         std::error_code ec;
         const auto file_bytes = std::filesystem::file_size(path, ec);
-        if (!ec && file_bytes < sat_add(uint64_t(h.vox_offset), data_bytes))
+        if (!ec && file_bytes < sat_add(offset, data_bytes))
             throw Error(path, "voxel data",
                         "truncated: expected " + std::to_string(data_bytes) +
-                            " bytes of voxels after offset " + std::to_string(h.vox_offset) +
+                            " bytes of voxels after offset " + std::to_string(offset) +
+                            (frame ? " (volume " + std::to_string(frame) + ")" : std::string()) +
                             ", the file has " +
-                            std::to_string(file_bytes > uint64_t(h.vox_offset)
-                                               ? file_bytes - uint64_t(h.vox_offset)
-                                               : 0));
+                            std::to_string(file_bytes > offset ? file_bytes - offset : 0));
     }
 
     Volume v(dims, type, path);
     set_geometry(h, v, path);
     check_geometry(v, path);  // before the voxels are read
-    if (gzseek(f.get(), z_off_t(h.vox_offset), SEEK_SET) != z_off_t(h.vox_offset))
+    // (a compressed file is inflated up to the offset; gzseek says -1 if the stream ends first)
+    if (offset > uint64_t(std::numeric_limits<z_off_t>::max()) ||
+        gzseek(f.get(), z_off_t(offset), SEEK_SET) != z_off_t(offset))
         throw Error(path, "voxel data",
-                    "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
+                    frame ? "truncated: the file ends before volume " + std::to_string(frame) +
+                                " at offset " + std::to_string(offset)
+                          : "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
     read_voxel_stream([&](void* buf, size_t n) { return gz_read_all(f.get(), buf, n, path); }, disk,
                       h.swap, v, path, opts.progress, rescale, h.slope, h.inter);
     return v;

@@ -16,6 +16,11 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
     Volume v;
     try {
         std::error_code ec;
+        const bool nifti = io::format_extension(path) == ".nii" || io::format_extension(path) == ".nii.gz";
+        if (opts.frame && *opts.frame != 0 && !nifti)
+            throw Error(path, "frame",
+                        "expected 0: this format is read as one volume (volumes are chosen in "
+                        "4D NIfTI files), got " + std::to_string(*opts.frame));
         if (!path.empty() && std::filesystem::is_directory(path, ec)) {
             v = io::read_dicom_dir(path, opts);
         } else {

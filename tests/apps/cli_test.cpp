@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "apps/cli_run.h"
+#include "io/io_test_util.h"
+#include "io/nifti_test_file.h"
 
 #include <filesystem>
 #include <fstream>
@@ -195,6 +197,44 @@ TEST(Cli, RawVolumeWithExplicitLayout) {
     EXPECT_EQ(ok.code, 0) << ok.err;
     CliRun bad = run("info " + raw.string() + " --dims 12x10x9 --type uint8");
     expect_one_line_error(bad, "ramp.raw");
+    // --spacing completes a raw layout, given by flags or by the file's name; nothing else.
+    CliRun spaced = run("info " + raw.string() + " --dims 12x10x8 --type uint8 --spacing 0.5,2,1.25");
+    EXPECT_EQ(spaced.code, 0) << spaced.err;
+    EXPECT_NE(spaced.out.find("spacing:     0.5 x 2 x 1.25 mm"), std::string::npos) << spaced.out;
+    const fs::path named = temp_dir() / "ramp_12x10x8_uint8.raw";
+    fs::copy_file(raw, named, fs::copy_options::overwrite_existing);
+    spaced = run("info " + named.string() + " --spacing 3,1,1");
+    EXPECT_NE(spaced.out.find("spacing:     3 x 1 x 1 mm"), std::string::npos) << spaced.out + spaced.err;
+    for (const char* s : {"0,1,1", "1,1", "1,1,1,1", "a,1,1", "nan,1,1", "1,-2,1"})
+        expect_one_line_error(run("info " + named.string() + " --spacing " + s), "--spacing");
+    expect_one_line_error(run("info " + small_volume().string() + " --spacing 1,1,1"),
+                          "--spacing: spacing: applies to .raw files");
+}
+
+// A 4D NIfTI file (three volumes) is read volume by volume with --frame; without it, one line
+// says how many it holds.
+TEST(Cli, FourDimensionalNiftiTakesAFrame) {
+    lacuna::test::NiftiSpec spec;
+    spec.ndim = 4;
+    spec.dims = {6, 5, 4};
+    spec.dim4 = 3;
+    std::vector<uint8_t> vox(6 * 5 * 4 * 3);
+    for (size_t i = 0; i < vox.size(); ++i) vox[i] = uint8_t(100 * (i / 120) + i % 120 / 12);
+    const fs::path file = temp_dir() / "series.nii";
+    lacuna::test::write_bytes(file.string(), lacuna::test::nifti_bytes(spec, vox.data(), vox.size()));
+    for (int f = 0; f < 3; ++f) {
+        CliRun r = run("info " + file.string() + " --frame " + std::to_string(f));
+        EXPECT_EQ(r.code, 0) << r.err;
+        const std::string range = std::to_string(100 * f) + " .. " + std::to_string(100 * f + 9);
+        EXPECT_NE(r.out.find("value range: " + range), std::string::npos) << r.out;
+    }
+    expect_one_line_error(run("info " + file.string()),
+                          "series.nii: frame: the file holds 3 volumes along dim[4]; choose one (0..2)");
+    expect_one_line_error(run("info " + file.string() + " --frame 3"), "frame: expected 0..2, got 3");
+    const fs::path png = temp_dir() / "series.png";
+    CliRun r = run("render " + file.string() + " --frame 2 --tf mr-default --size 16 --out " + png.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(png));
 }
 
 }  // namespace

@@ -100,6 +100,78 @@ TEST(IoNifti, AppliesSlopeAndInterceptAsFloat) {
     for (int i = 0; i < 8; ++i) EXPECT_FLOAT_EQ(v.data_as<float>()[i], vox[i] * 0.5f - 10.f);
 }
 
+// A 4D file: each frame is its own volume (frames stored one after another after vox_offset),
+// uncompressed and gzipped, NIfTI-1 and -2; the frame is range-checked against dim[4], and a
+// file whose last frame is cut is truncated for that frame only.
+TEST(IoNifti, ReadsTheChosenVolumeOfAFourDimensionalFile) {
+    ScratchDir dir;
+    for (const int version : {1, 2})
+        for (const bool gz : {false, true}) {
+            NiftiSpec spec;
+            spec.version = version;
+            spec.ndim = 4;
+            spec.dims = {3, 2, 2};
+            spec.dim4 = 3;
+            spec.datatype = 512;  // uint16
+            std::vector<uint16_t> vox(12 * 3);
+            for (size_t i = 0; i < vox.size(); ++i) vox[i] = uint16_t(1000 * (i / 12) + i % 12 + 1);
+            std::vector<uint8_t> bytes = test::nifti_bytes(spec, vox.data(), vox.size() * 2);
+            const std::string name = "t" + std::to_string(version) + (gz ? ".nii.gz" : ".nii");
+            test::write_bytes(dir.file(name), gz ? test::gzip(bytes) : bytes);
+            for (int64_t frame = 0; frame < 3; ++frame) {
+                ReadOptions ro;
+                ro.frame = frame;
+                const Volume v = read_volume(dir.file(name), ro);
+                ASSERT_EQ(v.dims(), (Vec3i{3, 2, 2})) << name;
+                for (int i = 0; i < 12; ++i)
+                    ASSERT_EQ(v.data_as<uint16_t>()[i], vox[size_t(12 * frame + i)]) << name << " " << frame;
+            }
+            for (const int64_t bad : {int64_t(3), int64_t(-1), int64_t(1) << 40}) {
+                ReadOptions ro;
+                ro.frame = bad;
+                const std::string msg = test::error_of([&] { read_volume(dir.file(name), ro); });
+                EXPECT_NE(msg.find(name + ": frame: expected 0..2, got " + std::to_string(bad)),
+                          std::string::npos)
+                    << msg;
+            }
+            if (!gz) {  // the last frame cut in half: frames 0 and 1 read, frame 2 is truncated
+                bytes.resize(bytes.size() - 12);
+                test::write_bytes(dir.file("cut" + name), bytes);
+                ReadOptions ro;
+                ro.frame = 1;
+                EXPECT_EQ(read_volume(dir.file("cut" + name), ro).data_as<uint16_t>()[0], 1001);
+                ro.frame = 2;
+                const std::string msg = test::error_of([&] { read_volume(dir.file("cut" + name), ro); });
+                EXPECT_NE(msg.find("voxel data: truncated: expected 24 bytes of voxels after offset"),
+                          std::string::npos)
+                    << msg;
+                EXPECT_NE(msg.find("(volume 2), the file has 12"), std::string::npos) << msg;
+            }
+        }
+}
+
+// A 3D file takes frame 0 only; other formats take no frame but 0.
+TEST(IoNifti, AThreeDimensionalFileHasOneFrame) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    const uint8_t vox[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    test::write_bytes(dir.file("one.nii"), test::nifti_bytes(spec, vox, sizeof vox));
+    ReadOptions ro;
+    ro.frame = 0;
+    EXPECT_EQ(read_volume(dir.file("one.nii"), ro).data_as<uint8_t>()[7], 8);
+    ro.frame = 1;
+    EXPECT_NE(test::error_of([&] { read_volume(dir.file("one.nii"), ro); })
+                  .find("one.nii: frame: expected 0..0 (the file holds one volume), got 1"),
+              std::string::npos);
+    const Volume v = read_volume(dir.file("one.nii"));
+    write_volume(dir.file("one.nrrd"), v);
+    EXPECT_NE(test::error_of([&] { read_volume(dir.file("one.nrrd"), ro); })
+                  .find("one.nrrd: frame: expected 0: this format is read as one volume"),
+              std::string::npos);
+    ro.frame = 0;
+    EXPECT_EQ(read_volume(dir.file("one.nrrd"), ro).dims(), v.dims());
+}
+
 TEST(IoNifti, AcceptsFourthDimensionOfOne) {
     ScratchDir dir;
     NiftiSpec spec;
