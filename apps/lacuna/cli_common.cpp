@@ -15,7 +15,7 @@ namespace lacuna::cli {
 
 void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required) {
     auto* opt = cmd.add_option("volume", a.path,
-                               "Volume file (.nii .nii.gz .nrrd .nhdr .mha .mhd .raw) or DICOM folder");
+                               "Volume file (.nii .nii.gz .hdr/.img .nrrd .nhdr .mha .mhd .raw) or DICOM folder");
     if (required) opt->required();
     cmd.add_option("--dims", a.raw_dims, "Raw files: dimensions, e.g. 301x370x316");
     cmd.add_option("--type", a.raw_type, "Raw files: voxel type (uint8, int16, uint16, float32)");

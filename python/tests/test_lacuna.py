@@ -221,6 +221,21 @@ def test_load_picks_a_volume_of_a_4d_nifti(tmp_path):
         lacuna.load(path, frame=3)
 
 
+def test_a_nifti_pair_loads_as_its_nii(tmp_path):
+    nib = pytest.importorskip("nibabel")
+    a = blobs(dtype=np.int16).T  # (x, y, z)
+    affine = np.array([[-0.5, 0, 0, 10], [0, 1.5, 0, -4], [0, 0, 2, 3], [0, 0, 0, 1]])
+    nib.save(nib.Nifti1Pair(a, affine), str(tmp_path / "pair.hdr"))
+    nib.save(nib.Nifti1Image(a, affine), str(tmp_path / "one.nii"))
+    one = lacuna.load(str(tmp_path / "one.nii"))
+    for name in ("pair.hdr", "pair.img"):
+        v = lacuna.load(str(tmp_path / name))
+        assert np.array_equal(v.array, one.array) and np.allclose(v.affine, one.affine), name
+    nib.save(nib.AnalyzeImage(a, affine), str(tmp_path / "analyze.hdr"))
+    with pytest.raises(OSError, match=r"analyze\.hdr: header: not a NIfTI-1 pair header"):
+        lacuna.load(str(tmp_path / "analyze.hdr"))
+
+
 # ---- Transfer functions --------------------------------------------------------------------------
 def test_transfer_functions_from_presets_files_and_points(tmp_path):
     assert "mr-brain" in lacuna.presets()

@@ -105,7 +105,9 @@ size_t gz_read_all(gzFile f, void* out, size_t n, const std::string& path) {
     return done;
 }
 
-NiftiHeader parse_header(gzFile f, const std::string& path) {
+// `pair`: the header of a two-file NIfTI (.hdr beside its .img), whose magic is ni1 / ni2 and
+// whose vox_offset counts from the start of the .img; otherwise a one-file .nii (n+1 / n+2).
+NiftiHeader parse_header(gzFile f, const std::string& path, bool pair) {
     uint8_t buf[540] = {};
     const size_t got = gz_read_all(f, buf, 348, path);
     if (got < 4) throw Error(path, "header", "not a NIfTI file (file is too short)");
@@ -132,12 +134,15 @@ NiftiHeader parse_header(gzFile f, const std::string& path) {
     const bool s = h.swap;
     if (h.version == 1) {
         const char* magic = reinterpret_cast<const char*>(buf + 344);
-        if (std::memcmp(magic, "ni1\0", 4) == 0)
+        if (!pair && std::memcmp(magic, "ni1\0", 4) == 0)
             throw Error(path, "header",
-                        "two-file NIfTI (.hdr/.img pair) is not supported; convert to .nii");
-        if (std::memcmp(magic, "n+1\0", 4) != 0)
+                        "the header says its voxels are in a separate .img file (magic 'ni1'): "
+                        "name it .hdr beside its .img");
+        if (std::memcmp(magic, pair ? "ni1\0" : "n+1\0", 4) != 0)
             throw Error(path, "header",
-                        "not a NIfTI-1 file (magic 'n+1' missing; Analyze 7.5 is not supported)");
+                        pair ? "not a NIfTI-1 pair header (magic 'ni1' missing; Analyze 7.5 headers "
+                               "are not read: their orientation is not in the file)"
+                             : "not a NIfTI-1 file (magic 'n+1' missing; Analyze 7.5 is not supported)");
         for (int i = 0; i < 8; ++i) h.dim[i] = get<int16_t>(buf, 40 + 2 * i, s);
         h.datatype = get<int16_t>(buf, 70, s);
         for (int i = 0; i < 8; ++i) h.pixdim[i] = get<float>(buf, 76 + 4 * i, s);
@@ -155,11 +160,14 @@ NiftiHeader parse_header(gzFile f, const std::string& path) {
             for (int c = 0; c < 4; ++c) h.srow[r][c] = get<float>(buf, 280 + 16 * r + 4 * c, s);
     } else {
         const char* magic = reinterpret_cast<const char*>(buf + 4);
-        if (std::memcmp(magic, "ni2\0", 4) == 0)
+        if (!pair && std::memcmp(magic, "ni2\0", 4) == 0)
             throw Error(path, "header",
-                        "two-file NIfTI (.hdr/.img pair) is not supported; convert to .nii");
-        if (std::memcmp(magic, "n+2\0", 4) != 0)
-            throw Error(path, "header", "not a NIfTI-2 file (magic 'n+2' missing)");
+                        "the header says its voxels are in a separate .img file (magic 'ni2'): "
+                        "name it .hdr beside its .img");
+        if (std::memcmp(magic, pair ? "ni2\0" : "n+2\0", 4) != 0)
+            throw Error(path, "header",
+                        pair ? "not a NIfTI-2 pair header (magic 'ni2' missing)"
+                             : "not a NIfTI-2 file (magic 'n+2' missing)");
         h.datatype = get<int16_t>(buf, 12, s);
         for (int i = 0; i < 8; ++i) h.dim[i] = get<int64_t>(buf, 16 + 8 * i, s);
         for (int i = 0; i < 8; ++i) h.pixdim[i] = get<double>(buf, 104 + 8 * i, s);
@@ -173,7 +181,7 @@ NiftiHeader parse_header(gzFile f, const std::string& path) {
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 4; ++c) h.srow[r][c] = get<double>(buf, 400 + 32 * r + 8 * c, s);
     }
-    if (h.vox_offset < int64_t(hdr_size))
+    if (!pair && h.vox_offset < int64_t(hdr_size))
         throw Error(path, "header",
                     "vox_offset " + std::to_string(h.vox_offset) +
                         " points inside the header (expected >= " + std::to_string(hdr_size) + ")");
@@ -469,11 +477,47 @@ void set_geometry(const NiftiHeader& h, Volume& v, const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// The files of a NIfTI volume: one .nii / .nii.gz, or a pair, named by either of its files:
+// name.hdr (or .hdr.gz) for the header and name.img (or .img.gz) for the voxels.
+struct NiftiFiles {
+    std::string header, data;
+    bool pair = false;
+};
+NiftiFiles nifti_files(const std::string& path) {
+    const std::string ext = format_extension(path);
+    if (ext != ".hdr" && ext != ".img" && ext != ".img.gz" && ext != ".hdr.gz") return {path, path, false};
+    const std::string stem = path.substr(0, path.size() - ext.size());
+    auto first = [&](std::initializer_list<const char*> exts) {
+        for (const char* e : exts)
+            if (std::filesystem::exists(stem + e)) return stem + e;
+        return stem + *exts.begin();
+    };
+    NiftiFiles f;
+    f.pair = true;
+    f.header = ext == ".hdr" || ext == ".hdr.gz" ? path : first({".hdr", ".hdr.gz"});
+    f.data = ext == ".img" || ext == ".img.gz" ? path : first({".img", ".img.gz"});
+    check_readable_file(f.header);
+    check_readable_file(f.data);
+    return f;
+}
+
+}  // namespace
+
 Volume read_nifti(const std::string& path, const ReadOptions& opts) {
-    GzFile f(gzopen(path.c_str(), "rb"));
-    if (!f) throw Error(path, "file", std::string("cannot open: ") + std::strerror(errno));
-    gzbuffer(f.get(), 1u << 20);
-    const NiftiHeader h = parse_header(f.get(), path);
+    const NiftiFiles files = nifti_files(path);
+    GzFile hf(gzopen(files.header.c_str(), "rb"));
+    if (!hf) throw Error(files.header, "file", std::string("cannot open: ") + std::strerror(errno));
+    gzbuffer(hf.get(), 1u << 20);
+    const NiftiHeader h = parse_header(hf.get(), files.header, files.pair);
+    // The voxels: after the header in the same stream, or in the pair's .img.
+    GzFile df(files.pair ? gzopen(files.data.c_str(), "rb") : nullptr);
+    if (files.pair && !df)
+        throw Error(files.data, "file", std::string("cannot open: ") + std::strerror(errno));
+    if (files.pair) gzbuffer(df.get(), 1u << 20);
+    gzFile f = files.pair ? df.get() : hf.get();
+    const std::string& data_path = files.data;
     const NiftiGrid grid = checked_dims(h, path);
     const Vec3i dims = grid.dims;
     const int64_t frame = chosen_frame(grid.frames, opts.frame, path);
@@ -493,11 +537,11 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     // An uncompressed file's length is known: report truncation before allocating. A
     // compressed one is inflated incrementally into the buffer, whose pages are only touched
     // as data arrives (Volume's constructor), so a short stream fails as fast as it ends.
-    if (gzdirect(f.get())) {
+    if (gzdirect(f)) {
         std::error_code ec;
-        const auto file_bytes = std::filesystem::file_size(path, ec);
+        const auto file_bytes = std::filesystem::file_size(data_path, ec);
         if (!ec && file_bytes < sat_add(offset, data_bytes))
-            throw Error(path, "voxel data",
+            throw Error(data_path, "voxel data",
                         "truncated: expected " + std::to_string(data_bytes) +
                             " bytes of voxels after offset " + std::to_string(offset) +
                             (frame ? " (volume " + std::to_string(frame) + ")" : std::string()) +
@@ -510,13 +554,13 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     check_geometry(v, path);  // before the voxels are read
     // (a compressed file is inflated up to the offset; gzseek says -1 if the stream ends first)
     if (offset > uint64_t(std::numeric_limits<z_off_t>::max()) ||
-        gzseek(f.get(), z_off_t(offset), SEEK_SET) != z_off_t(offset))
-        throw Error(path, "voxel data",
+        gzseek(f, z_off_t(offset), SEEK_SET) != z_off_t(offset))
+        throw Error(data_path, "voxel data",
                     frame ? "truncated: the file ends before volume " + std::to_string(frame) +
                                 " at offset " + std::to_string(offset)
                           : "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
-    read_voxel_stream([&](void* buf, size_t n) { return gz_read_all(f.get(), buf, n, path); }, disk,
-                      h.swap, v, path, opts.progress, rescale, h.slope, h.inter);
+    read_voxel_stream([&](void* buf, size_t n) { return gz_read_all(f, buf, n, data_path); }, disk,
+                      h.swap, v, data_path, opts.progress, rescale, h.slope, h.inter);
     return v;
 }
 

@@ -16,7 +16,8 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
     Volume v;
     try {
         std::error_code ec;
-        const bool nifti = io::format_extension(path) == ".nii" || io::format_extension(path) == ".nii.gz";
+        const std::string e = io::format_extension(path);
+        const bool nifti = e == ".nii" || e == ".nii.gz" || e == ".hdr" || e == ".img" || e == ".img.gz";
         if (opts.frame && *opts.frame != 0 && !nifti)
             throw Error(path, "frame",
                         "expected 0: this format is read as one volume (volumes are chosen in "
@@ -26,13 +27,10 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
         } else {
             io::check_readable_file(path);
             const std::string ext = io::format_extension(path);
-            if (ext == ".nii" || ext == ".nii.gz")
+            if (nifti)  // .nii, .nii.gz and the two-file pairs .hdr + .img (or .img.gz)
                 v = io::read_nifti(path, opts);
             else if (ext == ".raw")
                 v = io::read_raw(path, opts);
-            else if (ext == ".hdr" || ext == ".img" || ext == ".img.gz")
-                throw Error(path, "format",
-                            "Analyze/NIfTI .hdr/.img pairs are not supported; convert to .nii");
             else
                 v = io::read_itk(path, opts);
         }

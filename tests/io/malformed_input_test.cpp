@@ -405,13 +405,13 @@ TEST(IoMalformed, NiftiVoxOffsetInsideHeaderIsRejected) {
     expect_read_error(dir.file("offset.nii"), {"vox_offset"});
 }
 
-TEST(IoMalformed, TwoFileNiftiIsRejected) {
+TEST(IoMalformed, APairsHeaderNamedNiiIsRejected) {  // (pairs are read as .hdr + .img)
     ScratchDir dir;
     NiftiSpec spec;
     spec.magic = std::string("ni1\0", 4);
     std::vector<uint8_t> vox(8);
     test::write_bytes(dir.file("pair.nii"), test::nifti_bytes(spec, vox.data(), vox.size()));
-    expect_read_error(dir.file("pair.nii"), {".hdr/.img"});
+    expect_read_error(dir.file("pair.nii"), {"separate .img file (magic 'ni1'): name it .hdr beside its .img"});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -150,6 +150,78 @@ TEST(IoNifti, ReadsTheChosenVolumeOfAFourDimensionalFile) {
         }
 }
 
+// A two-file NIfTI (name.hdr + name.img or name.img.gz; magic ni1 / ni2, vox_offset counted in
+// the .img) reads as the one-file .nii with the same header and voxels, named by either file;
+// a missing or short .img is an error naming it; a .nii with a pair's magic and an Analyze
+// header (no magic) are refused.
+TEST(IoNifti, ReadsTwoFilePairsAsTheirOneFileNii) {
+    ScratchDir dir;
+    for (const int version : {1, 2}) {
+        NiftiSpec spec;
+        spec.version = version;
+        spec.dims = {4, 3, 2};
+        spec.ndim = 4;
+        spec.dim4 = 2;
+        spec.datatype = 4;  // int16
+        spec.pixdim = {0.5, 1.5, 2};
+        spec.sform_code = 1;
+        spec.srow = {{{-0.5, 0, 0, 10}, {0, 1.5, 0, -4}, {0, 0, 2, 3}}};
+        std::vector<int16_t> vox(48);
+        for (size_t i = 0; i < vox.size(); ++i) vox[i] = int16_t(37 * int(i) - 700);
+        const std::string v = std::to_string(version);
+        test::write_bytes(dir.file("one" + v + ".nii"), test::nifti_bytes(spec, vox.data(), 96));
+        spec.magic = version == 1 ? std::string("ni1\0", 4) : std::string("ni2\0\r\n\032\n", 8);
+        spec.vox_offset = 16;  // in the .img
+        std::vector<uint8_t> hdr = test::nifti_bytes(spec, nullptr, 0);
+        hdr.resize(version == 1 ? 348 : 540);
+        std::vector<uint8_t> img(16, 0);
+        img.insert(img.end(), reinterpret_cast<const uint8_t*>(vox.data()),
+                   reinterpret_cast<const uint8_t*>(vox.data()) + 96);
+        test::write_bytes(dir.file("pair" + v + ".hdr"), hdr);
+        test::write_bytes(dir.file("pair" + v + ".img"), img);
+        test::write_bytes(dir.file("gz" + v + ".hdr"), hdr);
+        test::write_bytes(dir.file("gz" + v + ".img.gz"), test::gzip(img));
+        for (const int64_t frame : {0, 1}) {
+            ReadOptions ro;
+            ro.frame = frame;
+            const Volume ref = read_volume(dir.file("one" + v + ".nii"), ro);
+            for (const char* name : {"pair", "gz"})
+                for (const char* ext : {".hdr", ".img"}) {
+                    const std::string file = dir.file(name + v + (ext == std::string(".img") && name == std::string("gz") ? ".img.gz" : ext));
+                    const Volume got = read_volume(file, ro);
+                    ASSERT_EQ(got.dims(), ref.dims()) << file;
+                    EXPECT_EQ(0, std::memcmp(got.data(), ref.data(), 24 * 2)) << file << " frame " << frame;
+                    EXPECT_EQ(to_string(got.spacing), to_string(ref.spacing)) << file;
+                    EXPECT_EQ(to_string(got.origin), to_string(ref.origin)) << file;
+                    for (int i = 0; i < 9; ++i) EXPECT_EQ(got.direction[i], ref.direction[i]) << file;
+                }
+        }
+        ReadOptions ro;
+        ro.frame = 1;
+        test::write_bytes(dir.file("short" + v + ".hdr"), hdr);
+        test::write_bytes(dir.file("short" + v + ".img"), std::vector<uint8_t>(img.begin(), img.end() - 2));
+        std::string msg = test::error_of([&] { read_volume(dir.file("short" + v + ".hdr"), ro); });
+        EXPECT_NE(msg.find("short" + v + ".img: voxel data: truncated"), std::string::npos) << msg;
+        test::write_bytes(dir.file("lonely" + v + ".hdr"), hdr);
+        msg = test::error_of([&] { read_volume(dir.file("lonely" + v + ".hdr"), ro); });
+        EXPECT_NE(msg.find("lonely" + v + ".img: file: does not exist"), std::string::npos) << msg;
+        test::write_bytes(dir.file("wrong" + v + ".nii"), test::nifti_bytes(spec, vox.data(), 96));
+        msg = test::error_of([&] { read_volume(dir.file("wrong" + v + ".nii"), ro); });
+        EXPECT_NE(msg.find("the header says its voxels are in a separate .img file"), std::string::npos) << msg;
+    }
+    NiftiSpec analyze;
+    analyze.magic = std::string("\0\0\0\0", 4);
+    analyze.vox_offset = 16;
+    std::vector<uint8_t> hdr = test::nifti_bytes(analyze, nullptr, 0);
+    hdr.resize(348);
+    test::write_bytes(dir.file("analyze.hdr"), hdr);
+    test::write_bytes(dir.file("analyze.img"), std::vector<uint8_t>(24, 1));
+    const std::string msg = test::error_of([&] { read_volume(dir.file("analyze.hdr")); });
+    EXPECT_NE(msg.find("analyze.hdr: header: not a NIfTI-1 pair header (magic 'ni1' missing; Analyze 7.5"),
+              std::string::npos)
+        << msg;
+}
+
 // A 3D file takes frame 0 only; other formats take no frame but 0.
 TEST(IoNifti, AThreeDimensionalFileHasOneFrame) {
     ScratchDir dir;
