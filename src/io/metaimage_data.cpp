@@ -148,7 +148,11 @@ MetaHeaderOrientation check_metaimage_header(const std::string& path) {
                             std::to_string(std::max(key.size(), value.size())) +
                             " characters, MetaImage allows " + std::to_string(kMaxField));
         if (eq == std::string::npos) continue;
-        if (to_lower(key) == "elementdatafile") return orientation;
+        // The header ends where MetaIO's ends: at the key ElementDataFile, spelt exactly so
+        // (MET_Read compares keys with strcmp). Stopping at any spelling let MetaIO parse on,
+        // unchecked, past an "elementDataFile" line into the voxels, where a key longer than its
+        // char[255] aborted in strcpy (fuzz_metaimage, 2026-12-02).
+        if (key == "ElementDataFile") return orientation;
         if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
             orientation.has_matrix = true;
         // A geometry number that is not finite ("nan", "inf", 1e999) made MetaIO stop reading

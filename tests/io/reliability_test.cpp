@@ -321,6 +321,28 @@ TEST(IoMetaImage, NDimsMetaIOWouldSeeIsCheckedWhateverItsSeparator) {
     EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
 }
 
+// fuzz_metaimage (2026-12-02): the header check stopped at "elementDataFile" (any spelling),
+// MetaIO only at "ElementDataFile" (strcmp), so MetaIO parsed on, unchecked, into the next
+// lines, and a key longer than its char[255] aborted in strcpy (fortify). The check now ends the
+// header where MetaIO does, so what MetaIO will read is what was checked.
+TEST(IoMetaImage, HeaderEndsOnlyWhereMetaIOEndsIt) {
+    ScratchDir dir;
+    const std::string head =
+        "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n";
+    test::write_text(dir.file("lower.mha"), head + "elementDataFile = LOCAL\n" +
+                                                std::string(300, 'K') + " = 1\n" +
+                                                std::string(8, '\0'));
+    const std::string msg = read_error(dir.file("lower.mha"));
+    EXPECT_NE(msg.find("lower.mha: header: line 6 has a key of 300 characters, MetaImage allows "
+                       "254"),
+              std::string::npos)
+        << msg;
+    // Spelt as MetaIO spells it, the key ends the header: what follows is voxels, not checked.
+    test::write_text(dir.file("ok.mha"), head + "ElementDataFile = LOCAL\n" +
+                                             std::string(8, 'K'));
+    EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
+}
+
 TEST(IoDetached, DataFileOutsideTheHeadersFolderNeedsPermission) {
     ScratchDir dir, other;
     test::write_bytes(other.file("data.raw"), std::vector<uint8_t>(64, 7));
