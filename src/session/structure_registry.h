@@ -15,20 +15,31 @@
 // (tests/session/session_test.cpp). accel_names(), all_accel_kinds(), parse_accel(),
 // box_source_names() and structure_of() read this table too: there is no second list.
 //
-// Adding a ray structure: its files in src/accel/, its AccelKind value (lacuna/accel.h) and its
-// case in visit_accel (src/accel/accel_impl.h: the once-per-frame dispatch to the concrete type),
-// an alternative of Structure with its parameters (lacuna/frame_spec.h), and one line here.
-// Parameters of a new shape also need their two lines in frame_spec.cpp (accel_options and
-// structure_of's fill) and their range check in validate_structure.
+// Adding a structure: its files (src/accel/ for a ray face, src/slice/ for a box face), its
+// alternative of Structure with its parameters (lacuna/frame_spec.h; a ray face also gets its
+// AccelKind value in lacuna/accel.h) and one line in kTable below. Everything else follows from
+// that line: the names, the factories, the capabilities table, the conformance tests, the
+// benchmarks' columns, and visit_accel (the once-per-frame dispatch to the concrete type, below),
+// which the renderers call through src/accel/accel_impl.h. Parameters of a new shape also need
+// their lines in frame_spec.cpp (accel_options and structure_of's fill) and their range check in
+// validate_structure.
 #pragma once
+#include <array>
 #include <iterator>
 #include <memory>
 #include <string>
-#include <type_traits>
 #include <optional>
+#include <tuple>
+#include <type_traits>
 #include <variant>
 
-#include "accel/accel_impl.h"
+#include "accel/bitfield_octree.h"
+#include "accel/boolean_octree.h"
+#include "accel/brick_grid.h"
+#include "accel/distance_map.h"
+#include "accel/kdtree.h"
+#include "accel/minmax_octree.h"
+#include "accel/no_accel.h"
 #include "lacuna/accel.h"
 #include "lacuna/frame_spec.h"
 #include "slice/box_sources.h"
@@ -77,22 +88,55 @@ inline std::unique_ptr<BoxSource> growing_boxes(const Volume& v, const AccelOpti
     return make_growing_boxes_source(v, bo);
 }
 
-inline constexpr Entry kStructures[] = {
-    //  name             kind                       ray face                       box face       labels
-    {"none",            AccelKind::None,            ray_face<NoAccel>,        whole_volume,  false},
-    {"distance",        AccelKind::Distance,        ray_face<DistanceMap>,    nullptr,       false},
-    {"chebyshev",       AccelKind::Chebyshev,       ray_face<DistanceMap>,    nullptr,       false},
-    {"boolean",         AccelKind::Boolean,         ray_face<BooleanOctree>,  nullptr,       false},
-    {"minmax",          AccelKind::MinMax,          ray_face<MinMaxOctree>,   nullptr,       false},
-    {"bitfield",        AccelKind::Bitfield,        ray_face<BitfieldOctree>, nullptr,       false},
-    {"kdtree",          AccelKind::KdTree,          ray_face<KdTree>,         kdtree_boxes,  false},
-    {"minmax-interval", AccelKind::MinMaxInterval,  ray_face<MinMaxOctree>,   nullptr,       false},
-    {"grid",            AccelKind::Grid,            ray_face<BrickGrid>,      nullptr,       false},
-    {"boxes",           std::nullopt,               nullptr,                  growing_boxes, false},
-    {"label-octree",    std::nullopt,               nullptr,                  nullptr,       true},
+// One line per structure: the Structure alternative it describes, the concrete ray type (void:
+// no ray face) with its AccelKind, and its name, box face and labels flag. The line's types are
+// what visit_accel dispatches to; its values become the Entry that everything else reads.
+template <class Spec, class Ray>
+struct Line {
+    using spec = Spec;  // the alternative of lacuna::Structure
+    using ray = Ray;    // the ray face's concrete type, void when there is none
+    Entry entry;
 };
-static_assert(std::size(kStructures) == std::variant_size_v<Structure>,
-              "one registry entry per alternative of lacuna::Structure");
+template <class Spec, class Ray = void>
+constexpr Line<Spec, Ray> line(const char* name, std::optional<AccelKind> kind,
+                               BoxFactory boxes = nullptr, bool labels = false) {
+    if constexpr (std::is_void_v<Ray>)
+        return {{name, kind, nullptr, boxes, labels}};
+    else
+        return {{name, kind, ray_face<Ray>, boxes, labels}};
+}
+
+inline constexpr std::tuple kTable{
+    //   alternative                ray face         name, kind, box face, labels
+    line<structure::None,           NoAccel>       ("none", AccelKind::None, whole_volume),
+    line<structure::Distance,       DistanceMap>   ("distance", AccelKind::Distance),
+    line<structure::Chebyshev,      DistanceMap>   ("chebyshev", AccelKind::Chebyshev),
+    line<structure::Boolean,        BooleanOctree> ("boolean", AccelKind::Boolean),
+    line<structure::MinMax,         MinMaxOctree>  ("minmax", AccelKind::MinMax),
+    line<structure::Bitfield,       BitfieldOctree>("bitfield", AccelKind::Bitfield),
+    line<structure::KdTree,         KdTree>        ("kdtree", AccelKind::KdTree, kdtree_boxes),
+    line<structure::MinMaxInterval, MinMaxOctree>  ("minmax-interval", AccelKind::MinMaxInterval),
+    line<structure::Grid,           BrickGrid>     ("grid", AccelKind::Grid),
+    line<structure::GrowingBoxes>                  ("boxes", std::nullopt, growing_boxes),
+    line<structure::LabelOctree>                   ("label-octree", std::nullopt, nullptr, true),
+};
+inline constexpr size_t kCount = std::tuple_size_v<decltype(kTable)>;
+template <size_t I>
+using LineAt = std::remove_cvref_t<decltype(std::get<I>(kTable))>;
+
+// Line I describes alternative I of Structure: the variant's order is the table's.
+static_assert(kCount == std::variant_size_v<Structure>,
+              "one registry line per alternative of lacuna::Structure");
+template <size_t I>
+constexpr bool kDescribes = std::is_same_v<typename LineAt<I>::spec,
+                                           std::variant_alternative_t<I, Structure>>;
+static_assert([]<size_t... I>(std::index_sequence<I...>) { return (kDescribes<I> && ...); }(
+                  std::make_index_sequence<kCount>{}),
+              "registry line I must describe alternative I of Structure");
+
+// The entries, in table order (what the names, factories and capabilities iterate).
+inline constexpr std::array<Entry, kCount> kStructures = std::apply(
+    [](const auto&... l) { return std::array<Entry, kCount>{l.entry...}; }, kTable);
 
 inline const Entry& entry(const Structure& s) { return kStructures[s.index()]; }
 // The entry named `name` (nullptr: none).
@@ -106,4 +150,30 @@ inline const Entry* find(const std::string& name) {
 template <class T>
 constexpr bool kHasOctree = requires(T t) { t.octree; };
 
+// ---- The dispatch to the concrete ray type (STYLE.md habit 2) --------------------------------
+// visit_accel(a, f) calls f with `a` as the concrete type of the line whose kind is a.kind(),
+// once per frame, so the cursor of that type inlines into the renderer's sample loop. The chain
+// of kind tests is generated from kTable (a kind shared by two lines, none is, would take the
+// first); a kind outside the table falls back to NoAccel, the reference (every sample).
+template <size_t I, class F>
+decltype(auto) visit_from(const Accel& a, F&& f) {
+    if constexpr (I == kCount) {
+        return f(static_cast<const NoAccel&>(a));
+    } else {
+        using Ray = typename LineAt<I>::ray;
+        if constexpr (!std::is_void_v<Ray>)
+            if (std::get<I>(kTable).entry.ray == a.kind()) return f(static_cast<const Ray&>(a));
+        return visit_from<I + 1>(a, std::forward<F>(f));
+    }
+}
+
 }  // namespace lacuna::registry
+
+namespace lacuna {
+
+template <class F>
+decltype(auto) visit_accel(const Accel& a, F&& f) {
+    return registry::visit_from<0>(a, std::forward<F>(f));
+}
+
+}  // namespace lacuna
