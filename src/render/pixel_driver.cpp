@@ -7,11 +7,11 @@
 
 namespace lacuna {
 
-// The RGBA8 word of `acc` over the background.
-static uint32_t pixel_word(const RenderOptions& opt, const kernel::Accum& acc) {
+// The RGBA8 word of `acc` over the background (pixel_word, pixel_driver.h).
+static inline uint32_t word_of(const Vec3f& background, const kernel::Accum& acc) {
     const float w = 1.f - acc.a;
-    const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
-                          acc.b + w * opt.background.z};
+    const float rgb[3] = {acc.r + w * background.x, acc.g + w * background.y,
+                          acc.b + w * background.z};
     // std::lround of clamp(c, 0, 1) * 255 per channel, for c in [0, 255] without the libm call:
     // x - trunc(x) is exact there, so the half-away-from-zero test is exact too. NaN becomes 0.
 #if defined(__SSE4_1__)
@@ -39,11 +39,17 @@ static uint32_t pixel_word(const RenderOptions& opt, const kernel::Accum& acc) {
 #endif
 }
 
-uint32_t empty_pixel_word(const RenderOptions& opt) { return pixel_word(opt, kernel::Accum{}); }
+uint32_t pixel_word(const Vec3f& background, const kernel::Accum& acc) {
+    return word_of(background, acc);
+}
+
+uint32_t empty_pixel_word(const RenderOptions& opt) {
+    return word_of(opt.background, kernel::Accum{});
+}
 
 void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
                  const kernel::Accum& acc, uint32_t samples) {
-    const uint32_t word = pixel_word(opt, acc);
+    const uint32_t word = word_of(opt.background, acc);
     std::memcpy(out.image.pixel(x, y), &word, 4);
     const size_t p = size_t(y) * size_t(out.image.width) + size_t(x);
     if (opt.keep_float) {

@@ -114,6 +114,13 @@ inline void for_each_sample(Cursor& cursor, float t_base, float dt, int k_end, F
     });
 }
 
+// The one pixel write-out of every renderer: the background composited behind the premultiplied
+// `acc` (c + (1 - a) * background per channel), each channel clamped to [0, 1], times 255,
+// rounded half away from zero (std::lround; NaN becomes 0), alpha 255; the RGBA8 bytes as one
+// word in memory order. The ray marcher's paths write it through write_pixel below, the slicer
+// (src/slice/slice_renderer.cpp) its framebuffer through it directly.
+uint32_t pixel_word(const Vec3f& background, const kernel::Accum& acc);
+
 // Composites the background behind `acc` and writes pixel (x, y) of `out`: RGBA8, and the float
 // RGBA and the sample count when the options ask for them. Out of line on purpose: inlined into
 // the ray marcher's tile loop it changed the compiler's inlining of the batch kernel and cost

@@ -5,11 +5,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 
 #include "core/parallel.h"
 #include "lacuna/error.h"
 #include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
+#include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 #include "slice/polygon.h"
 
@@ -244,13 +247,11 @@ double cells_of(const Vec3d& lo, const Vec3d& hi) {
     return std::max(hi.x - lo.x, 0.0) * std::max(hi.y - lo.y, 0.0) * std::max(hi.z - lo.z, 0.0);
 }
 
-}  // namespace
+// ---- The steps of a frame (SliceRenderer::render runs them in order) ---------------------------
 
-SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& opt,
-                                  AdaptiveUpdates* adaptive) const {
-    // World (RAS) -> the volume frame, where the boxes and rays live (lacuna/orientation.h).
-    const Camera cam = to_volume_frame(volume_frame(m_volume), world_cam);
-    if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
+// 0. What a frame needs; FrameErrors name the FrameSpec field (lacuna/frame_spec.h).
+void check_frame(const TransferLut& lut, const Camera& cam, const SliceOptions& opt) {
+    if (lut.entries.empty()) throw Error("render", "transfer function", "none was set");
     if (!(opt.step > 0.f) || !std::isfinite(opt.step))
         throw FrameError("sampling.step", "expected a positive number");
     if (cam.width() < 1 || cam.height() < 1)
@@ -261,23 +262,18 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
             throw FrameError("slicer.occlusion_threshold", "expected 0 < T <= 1");
         if (oo.map_size < 1 || oo.map_size > 4096)
             throw FrameError("slicer.occlusion_map", "expected 1..4096 cells");
-        if (oo.updates < 0) throw Error("occlusion", "updates", "expected >= 0");
+        if (oo.updates < 0) throw FrameError("slicer.occlusion_updates", "expected >= 0");
     }
-    const auto t_start = Clock::now();
-    const double cpu_start = process_cpu_seconds();
+}
+
+// 1. Per pixel: the camera ray in index space (t in world units) and the terms of t on plane k.
+PixelRays pixel_rays(const Camera& cam, const Vec3f& inv_sp, int threads) {
     const int W = cam.width(), H = cam.height();
     const size_t np = size_t(W) * size_t(H);
-    SliceResult out;
-    out.image = Image(W, H);
-    SliceStats& st = out.stats;
-
-    // 1. Per-pixel rays (index space) and plane terms.
-    const Vec3d sp = m_volume.spacing;
-    const Vec3f inv_sp{float(1.0 / sp.x), float(1.0 / sp.y), float(1.0 / sp.z)};
     const Vec3f eye = cam.eye(), fwd = cam.forward();
     PixelRays px;
     for (auto* v : {&px.ox, &px.oy, &px.oz, &px.dx, &px.dy, &px.dz, &px.a, &px.c}) v->resize(np);
-    parallel_for(size_t(H), opt.threads, [&](size_t r0, size_t r1) {
+    parallel_for(size_t(H), threads, [&](size_t r0, size_t r1) {
         for (size_t y = r0; y < r1; ++y)
             for (int x = 0; x < W; ++x) {
                 const size_t i = y * size_t(W) + size_t(x);
@@ -289,74 +285,61 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
                 px.c[i] = 1.f / dot(wr.dir, fwd);
             }
     });
+    return px;
+}
 
-    // 2. The boxes, front to back.
-    const Vec3i dims = m_volume.dims();
-    const int cells[3] = {dims.x - 1, dims.y - 1, dims.z - 1};
-    std::vector<CellBox> boxes;
-    if (m_source) {
-        const Vec3f e_idx = eye * inv_sp, f_idx = fwd * inv_sp;
-        boxes = cam.projection() == Projection::Orthographic
-                    ? m_source->boxes_front_to_back_along(f_idx)
-                    : m_source->boxes_front_to_back(e_idx);
-    } else {
-        boxes.push_back({{0, 0, 0}, {cells[0], cells[1], cells[2]}});
-    }
-    st.boxes = boxes.size();
-    for (const CellBox& b : boxes)
-        st.voxels += cells_of({double(b.lo[0]), double(b.lo[1]), double(b.lo[2])},
-                              {double(b.hi[0]), double(b.hi[1]), double(b.hi[2])});
+// 2. The boxes, front to back: the source's for this view, or the whole volume ('Basic').
+std::vector<CellBox> boxes_in_order(const BoxSource* source, const Camera& cam, const Vec3f& inv_sp,
+                                    const int cells[3]) {
+    if (!source) return {{{0, 0, 0}, {cells[0], cells[1], cells[2]}}};
+    return cam.projection() == Projection::Orthographic
+               ? source->boxes_front_to_back_along(cam.forward() * inv_sp)
+               : source->boxes_front_to_back(cam.eye() * inv_sp);
+}
 
+// The planes' geometry and the screen projection of the frame.
+Frame frame_geometry(const Camera& cam, const Vec3d& sp, float step) {
     Frame f;
     f.cam = &cam;
-    f.eye_world = Vec3d(eye);
-    f.fwd = Vec3d(fwd);
+    f.eye_world = Vec3d(cam.eye());
+    f.fwd = Vec3d(cam.forward());
     f.sp = sp;
     const float min_sp = float(std::min({sp.x, sp.y, sp.z}));
-    f.dt_f = opt.step * min_sp;
+    f.dt_f = step * min_sp;
     f.dt = double(f.dt_f);
-    const double aspect = double(W) / double(H);
+    const double W = double(cam.width()), H = double(cam.height());
     f.screen = {f.eye_world, Vec3d(cam.right()), Vec3d(cam.up()), f.fwd, sp,
-                aspect * cam.half_height(), double(cam.half_height()), double(W), double(H),
+                W / H * cam.half_height(), double(cam.half_height()), W, H,
                 cam.projection() == Projection::Perspective};
     f.screen.prepare();
+    return f;
+}
 
-    // 3. Occlusion: the map's geometry and each pixel's cells, the DeltaVoxels schedule.
-    const bool occl = oo.mode != OcclusionMode::Off;
-    std::unique_ptr<OcclusionMap> omap;
-    double delta_voxels = INFINITY;
-    if (occl) {
-        const auto t0 = Clock::now();
-        omap = std::make_unique<OcclusionMap>(cam, dims, sp, oo.map_size);
-        omap->assign_pixels(px.ox, px.oy, px.oz, px.dx, px.dy, px.dz);
-        st.desired_updates = adaptive ? adaptive->desired() : oo.updates;
-        delta_voxels = st.voxels / double(st.desired_updates + 1);
-        st.occlusion_seconds += seconds_since(t0);
-    }
-
-    std::vector<kernel::Accum> fb(np);
-    const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
-    const ValueToLut vmap = m_lut.map();
-    std::atomic<uint64_t> samples{0};
-    const float ert = opt.ert >= 1.f ? kNoEarlyTermination : opt.ert;
-
-    // 4. Batches of boxes between map updates (one batch without occlusion).
+// 4a. The boxes of the next batch: from `next` on, culled and clipped against the current map,
+// until DeltaVoxels more voxels are rendered (a map update follows: update_after) or the boxes
+// end. Without occlusion (delta = infinity) that is one batch of every box.
+struct BatchCutter {
+    const std::vector<CellBox>& boxes;
+    const OcclusionOptions& oo;
+    const OcclusionMap* map;  // null: no occlusion
+    const int* cells;
+    double delta_voxels;
+    size_t next = 0;
     double rendered = 0, next_update = delta_voxels;
-    size_t next_box = 0;
-    std::vector<BoxWork> work;
-    while (next_box < boxes.size()) {
-        // 4a. Cull and clip the boxes of the batch against the current map.
-        const auto t_occ = Clock::now();
+
+    bool done() const { return next >= boxes.size(); }
+    // Fills `work` and `regions` (the clipped box of each); returns update_after.
+    bool cut(std::vector<BoxWork>& work, std::vector<std::pair<Vec3d, Vec3d>>& regions,
+             SliceStats& st) {
         work.clear();
-        bool update_after = false;
-        std::vector<std::pair<Vec3d, Vec3d>> regions;
-        while (next_box < boxes.size()) {
-            const CellBox& cb = boxes[next_box++];
+        regions.clear();
+        while (next < boxes.size()) {
+            const CellBox& cb = boxes[next++];
             const Vec3d lo{double(cb.lo[0]), double(cb.lo[1]), double(cb.lo[2])};
             const Vec3d hi{double(cb.hi[0]), double(cb.hi[1]), double(cb.hi[2])};
             Vec3d rlo = lo, rhi = hi;
-            if (occl && omap->valid()) {
-                const BoxClip bc = clip_box(*omap, lo, hi, oo.threshold);
+            if (map && map->valid()) {
+                const BoxClip bc = clip_box(*map, lo, hi, oo.threshold);
                 const double vol = cells_of(lo, hi);
                 if (oo.mode == OcclusionMode::CullClip || oo.mode == OcclusionMode::CullOnly) {
                     if (bc.culled) {
@@ -384,45 +367,139 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
             work.push_back(std::move(w));
             regions.push_back({rlo, rhi});
             rendered += cells_of(rlo, rhi);
-            if (occl && rendered >= next_update && next_box < boxes.size()) {
+            if (map && rendered >= next_update && next < boxes.size()) {
                 next_update = (std::floor(rendered / delta_voxels) + 1) * delta_voxels;
-                update_after = true;
-                break;
+                return true;
             }
         }
-        if (occl) st.occlusion_seconds += seconds_since(t_occ);
+        return false;
+    }
+};
 
-        // 4b. Slicing polygons of every box in the batch (incremental intersection).
-        const auto t_setup = Clock::now();
-        std::vector<uint64_t> polys(work.size(), 0);
-        std::atomic<int64_t> setup_cpu_ns{0};
-        parallel_for(work.size(), opt.threads, [&](size_t b0, size_t b1) {
-            const double c0 = thread_cpu_seconds();
-            for (size_t b = b0; b < b1; ++b)
-                set_up_box(f, regions[b].first, regions[b].second, work[b], polys[b]);
-            setup_cpu_ns += int64_t(1e9 * (thread_cpu_seconds() - c0));
-        });
-        st.setup_cpu_seconds += 1e-9 * double(setup_cpu_ns.load());
-        for (uint64_t n : polys) st.polygons += n;
-        st.setup_seconds += seconds_since(t_setup);
+// 4b. The slicing polygons of every box of the batch (incremental intersection), in parallel;
+// their wall and CPU time go to the set-up counters.
+void set_up_batch(const Frame& f, const std::vector<std::pair<Vec3d, Vec3d>>& regions,
+                  std::vector<BoxWork>& work, int threads, SliceStats& st) {
+    const auto t_setup = Clock::now();
+    std::vector<uint64_t> polys(work.size(), 0);
+    std::atomic<int64_t> setup_cpu_ns{0};
+    parallel_for(work.size(), threads, [&](size_t b0, size_t b1) {
+        const double c0 = thread_cpu_seconds();
+        for (size_t b = b0; b < b1; ++b)
+            set_up_box(f, regions[b].first, regions[b].second, work[b], polys[b]);
+        setup_cpu_ns += int64_t(1e9 * (thread_cpu_seconds() - c0));
+    });
+    st.setup_cpu_seconds += 1e-9 * double(setup_cpu_ns.load());
+    for (uint64_t n : polys) st.polygons += n;
+    st.setup_seconds += seconds_since(t_setup);
+}
 
-        // 4c. Composite the batch, tile by tile.
+// What compositing a batch reads: the step-corrected LUT, the value-to-entry map, the rays.
+struct Compositor {
+    const Volume& volume;
+    const std::vector<Rgba>& lut;
+    ValueToLut map;
+    const PixelRays& px;
+    float dt, ert;
+    bool nearest;
+    int width, height, tile, threads;
+
+    // 4c. Composites the batch into `fb`, tile by tile; returns the samples taken.
+    uint64_t composite(const std::vector<BoxWork>& work, kernel::Accum* fb) const {
         std::vector<const BoxWork*> batch;
         for (const BoxWork& w : work) batch.push_back(&w);
-        visit_voxels(m_volume, [&](const auto* data) {
+        std::atomic<uint64_t> samples{0};
+        visit_voxels(volume, [&](const auto* data) {
             using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
-            const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, dims);
-            parallel_for_tiles(W, H, std::max(opt.tile, 1), opt.threads,
+            const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, volume.dims());
+            parallel_for_tiles(width, height, std::max(tile, 1), threads,
                                [&](int x0, int y0, int x1, int y1) {
                                    uint64_t n = 0;
-                                   raster_tile(g, lut.data(), vmap, px, batch, f.dt_f, ert,
-                                               opt.nearest, W, x0, y0, x1, y1, fb.data(), n);
+                                   raster_tile(g, lut.data(), map, px, batch, dt, ert, nearest,
+                                               width, x0, y0, x1, y1, fb, n);
                                    samples += n;
                                });
         });
+        return samples;
+    }
+};
 
-        // 4d. Map update after DeltaVoxels more voxels.
-        if (update_after) {
+// 5. The framebuffer over the background in 8 bits, by the ray marcher's write-out
+// (pixel_word, render/pixel_driver.h), and the float RGBA when asked.
+void write_out(const std::vector<kernel::Accum>& fb, const SliceOptions& opt, SliceResult& out) {
+    const size_t np = fb.size();
+    if (opt.keep_float) out.rgba_float.resize(np * 4);
+    for (size_t i = 0; i < np; ++i) {
+        const kernel::Accum& acc = fb[i];
+        const uint32_t word = pixel_word(opt.background, acc);
+        std::memcpy(&out.image.rgba[i * 4], &word, 4);
+        if (opt.keep_float) {
+            float* q = &out.rgba_float[i * 4];
+            q[0] = acc.r, q[1] = acc.g, q[2] = acc.b, q[3] = acc.a;
+        }
+    }
+}
+
+}  // namespace
+
+// A frame in five steps: the rays (1), the boxes in visibility order (2), the occlusion map (3),
+// then batch after batch of boxes between map updates: cut and clip (4a), slicing polygons (4b),
+// compositing (4c), the map update (4d); finally the write-out (5).
+SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& opt,
+                                  AdaptiveUpdates* adaptive) const {
+    // World (RAS) -> the volume frame, where the boxes and rays live (lacuna/orientation.h).
+    const Camera cam = to_volume_frame(volume_frame(m_volume), world_cam);
+    check_frame(m_lut, cam, opt);
+    const auto t_start = Clock::now();
+    const double cpu_start = process_cpu_seconds();
+    const int W = cam.width(), H = cam.height();
+    SliceResult out;
+    out.image = Image(W, H);
+    SliceStats& st = out.stats;
+
+    // 1. Rays; 2. boxes.
+    const Vec3d sp = m_volume.spacing;
+    const Vec3f inv_sp{float(1.0 / sp.x), float(1.0 / sp.y), float(1.0 / sp.z)};
+    const PixelRays px = pixel_rays(cam, inv_sp, opt.threads);
+    const Vec3i dims = m_volume.dims();
+    const int cells[3] = {dims.x - 1, dims.y - 1, dims.z - 1};
+    const std::vector<CellBox> boxes = boxes_in_order(m_source, cam, inv_sp, cells);
+    st.boxes = boxes.size();
+    for (const CellBox& b : boxes)
+        st.voxels += cells_of({double(b.lo[0]), double(b.lo[1]), double(b.lo[2])},
+                              {double(b.hi[0]), double(b.hi[1]), double(b.hi[2])});
+    const Frame f = frame_geometry(cam, sp, opt.step);
+
+    // 3. Occlusion: the map's geometry and each pixel's cells, the DeltaVoxels schedule.
+    const OcclusionOptions& oo = opt.occlusion;
+    std::unique_ptr<OcclusionMap> omap;
+    double delta_voxels = INFINITY;
+    if (oo.mode != OcclusionMode::Off) {
+        const auto t0 = Clock::now();
+        omap = std::make_unique<OcclusionMap>(cam, dims, sp, oo.map_size);
+        omap->assign_pixels(px.ox, px.oy, px.oz, px.dx, px.dy, px.dz);
+        st.desired_updates = adaptive ? adaptive->desired() : oo.updates;
+        delta_voxels = st.voxels / double(st.desired_updates + 1);
+        st.occlusion_seconds += seconds_since(t0);
+    }
+
+    // 4. Batches of boxes between map updates (one batch without occlusion).
+    std::vector<kernel::Accum> fb(size_t(W) * size_t(H));
+    const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
+    const Compositor comp{m_volume, lut, m_lut.map(), px,
+                          f.dt_f, opt.ert >= 1.f ? kNoEarlyTermination : opt.ert,
+                          opt.nearest, W, H, opt.tile, opt.threads};
+    BatchCutter cutter{boxes, oo, omap.get(), cells, delta_voxels};
+    std::vector<BoxWork> work;
+    std::vector<std::pair<Vec3d, Vec3d>> regions;
+    uint64_t samples = 0;
+    while (!cutter.done()) {
+        const auto t_occ = Clock::now();
+        const bool update_after = cutter.cut(work, regions, st);  // 4a
+        if (omap) st.occlusion_seconds += seconds_since(t_occ);
+        set_up_batch(f, regions, work, opt.threads, st);           // 4b
+        samples += comp.composite(work, fb.data());                // 4c
+        if (update_after) {                                        // 4d
             const auto t0 = Clock::now();
             omap->update(&fb[0].a, 4);
             ++st.map_updates;
@@ -430,25 +507,12 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
         }
     }
 
-    // 5. Background and 8 bits, as the ray marcher.
-    if (opt.keep_float) out.rgba_float.resize(np * 4);
-    for (size_t i = 0; i < np; ++i) {
-        const kernel::Accum& acc = fb[i];
-        const float w = 1.f - acc.a;
-        const float rgb[3] = {acc.r + w * opt.background.x, acc.g + w * opt.background.y,
-                              acc.b + w * opt.background.z};
-        uint8_t* p = &out.image.rgba[i * 4];
-        for (int c = 0; c < 3; ++c) p[c] = uint8_t(std::lround(std::clamp(rgb[c], 0.f, 1.f) * 255.f));
-        p[3] = 255;
-        if (opt.keep_float) {
-            float* q = &out.rgba_float[i * 4];
-            q[0] = acc.r, q[1] = acc.g, q[2] = acc.b, q[3] = acc.a;
-        }
-    }
+    // 5. Background and 8 bits.
+    write_out(fb, opt, out);
     st.samples = samples;
     st.seconds = seconds_since(t_start);
     st.cpu_seconds = process_cpu_seconds() - cpu_start;
-    if (adaptive && occl) adaptive->report(st.skipped_fraction(), st.map_updates);
+    if (adaptive && omap) adaptive->report(st.skipped_fraction(), st.map_updates);
     return out;
 }
 
