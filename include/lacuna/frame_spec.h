@@ -149,10 +149,25 @@ struct Sampling {
     Interpolation interpolation = Interpolation::Trilinear;
 };
 
+// What the slicer does with its opacity map (growing-boxes paper, Section 4): the method culls
+// and clips boxes against it; the other two are the paper's ablations (its ESS+C and ESS+M).
+enum class OcclusionUse {
+    CullClip,  // cull hidden boxes, clip the rest to their visible part
+    CullOnly,  // cull only
+    MapOnly,   // every map update and box test, nothing skipped: the map's overhead alone
+};
+
 struct SlicerSpec {
     bool occlusion = false;          // occlusion culling and clipping against the opacity map
     float occlusion_threshold = 0.95f;  // (0, 1]; 1 is exact
     int occlusion_map = 64;          // map edge in cells, 1..4096
+    OcclusionUse occlusion_use = OcclusionUse::CullClip;
+    int occlusion_updates = 9;       // map updates per frame (k), >= 0
+    // Section 4.4's controller picks the updates per frame instead, from occlusion_updates on,
+    // learning from the frame before. It learns over the session's consecutive frames with this
+    // structure and slicer spec; any other frame in between starts it afresh.
+    bool adaptive_updates = false;
+    friend bool operator==(const SlicerSpec&, const SlicerSpec&) = default;
 };
 
 struct SegmentsSpec {

@@ -34,6 +34,8 @@
 
 namespace lacuna {
 
+class BoxSource;  // src/slice/box_source.h
+
 // The slicer's counters (src/slice/slice_renderer.h SliceStats), for the front ends' reports.
 struct SlicerFrameStats {
     uint64_t boxes = 0, polygons = 0;
@@ -42,6 +44,7 @@ struct SlicerFrameStats {
     uint64_t boxes_culled = 0, boxes_clipped = 0;
     double skipped_fraction = 0, culled_fraction = 0, clipped_fraction = 0;
     double occlusion_seconds = 0;
+    double voxels = 0;  // cells in the frame's boxes (the box source's non-empty cells)
 };
 
 struct FrameResult {
@@ -104,6 +107,11 @@ public:
     void drop_structures();
     // How many structures, box sources and segment renderers are built (tests, reports).
     size_t built_count() const;
+    // What frames of `spec` render through, as built (nullptr: not built yet, or the spec's
+    // renderer does not use one): for reports and tests that look inside a structure (the
+    // benches' kd-tree list, the growing boxes' build phases). Rendering never needs them.
+    const Accel* built_structure(const FrameSpec& spec) const;
+    const BoxSource* built_box_source(const FrameSpec& spec) const;
 
 private:
     void check_tfs(const FrameSpec& spec) const;

@@ -71,6 +71,7 @@ BenchDataset make_dataset(std::string name, std::string description,
     d.name = std::move(name);
     d.description = std::move(description);
     d.tf_name = tf.name;
+    d.tf = tf;
     d.lut = discretise(tf, volume->vis_range());
     d.volume = std::move(volume);
     return d;

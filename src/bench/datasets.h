@@ -35,7 +35,8 @@ struct BenchDataset {
     std::string description;  // where it came from, e.g. "ch2better.nii.gz (mricron), mr-gap"
     std::shared_ptr<const Volume> volume;
     std::string tf_name;
-    TransferLut lut;  // discretised over the volume's visualization range
+    TransferFunction tf;  // what a Session renders it with (Session::set_transfer_function)
+    TransferLut lut;      // tf discretised over the volume's visualization range
 };
 
 struct DatasetSource {

@@ -8,7 +8,9 @@
 #include "accel/cell_ranges.h"
 #include "accel/kdtree.h"
 #include "lacuna/error.h"
+#include "lacuna/frame_spec.h"
 #include "lacuna/renderer.h"
+#include "lacuna/session.h"
 #include "volume/resample.h"
 
 namespace lacuna::bench {
@@ -227,15 +229,16 @@ KdDatasetResult run_kd_dataset(const BenchDataset& d, int size, const KdBenchOpt
         out.lists.push_back(lr);
     }
 
-    // 4. Rendering: none, then kdtree at every M, over the same orbit.
-    RayMarcher marcher(*d.volume);
-    marcher.set_transfer_function(d.lut);
-    const std::vector<Camera> cams = orbit_cameras(marcher.bounds(), o.orbit);
-    RenderOptions ro;
-    ro.step = o.step;
-    ro.ert = o.ert;
-    ro.threads = o.threads;
-    OrbitRun none = run_orbit(marcher, cams, ro);
+    // 4. Rendering: none, then kdtree at every M, over the same orbit, through one session.
+    Session session(*d.volume, o.threads);  // shares the voxels
+    session.set_transfer_function(d.tf);
+    FrameSpec base;
+    base.structure = structure::None{};
+    base.sampling.step = o.step;
+    base.sampling.early_termination = o.ert;
+    if (o.ert >= 1.f) base.sampling.early_termination.reset();  // ">= 1: off"
+    const std::vector<FrameSpec> none_frames = orbit_frames(base, o.orbit);
+    OrbitRun none = run_orbit(session, none_frames);
     {
         std::vector<double> ms;
         for (double s : none.frame_seconds) ms.push_back(s * 1e3);
@@ -252,16 +255,16 @@ KdDatasetResult run_kd_dataset(const BenchDataset& d, int size, const KdBenchOpt
     for (KdListResult& lr : out.lists) {
         AccelOptions mo = ao;
         mo.kd_max_boxes = lr.max_boxes;
-        std::unique_ptr<Accel> accel = make_accel(AccelKind::KdTree, *d.volume, mo);
-        accel->set_transfer_function(d.lut);
-        lr.build_ms = accel->stats().tf_update_seconds * 1e3;
-        const auto* kd = dynamic_cast<const KdTree*>(accel.get());
+        std::vector<FrameSpec> frames = none_frames;
+        for (FrameSpec& f : frames) f.structure = structure_of(AccelKind::KdTree, mo);
+        const FrameResult built = session.prepare(frames[0]);
+        lr.build_ms = built.structure ? built.structure->tf_update_seconds * 1e3 : 0;
+        const auto* kd = dynamic_cast<const KdTree*>(session.built_structure(frames[0]));
         if (!kd || int(kd->partition().list().size()) != lr.boxes)
             throw Error("bench kdtree", "list",
                         "the rendering structure's list differs from the measured one (a bug)");
-        marcher.set_accel(accel.get());
-        const OrbitRun run = run_orbit(marcher, cams, ro);
-        marcher.set_accel(nullptr);
+        const OrbitRun run = run_orbit(session, frames);
+        session.drop_structures();
         std::vector<double> ms;
         for (double s : run.frame_seconds) ms.push_back(s * 1e3);
         lr.frame_ms = summarize(ms);

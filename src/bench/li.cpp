@@ -7,10 +7,9 @@
 
 #include "bench/stats.h"
 #include "lacuna/error.h"
-#include "lacuna/renderer.h"
-#include "slice/box_sources.h"
+#include "lacuna/frame_spec.h"
+#include "lacuna/session.h"
 #include "slice/growing_boxes_source.h"
-#include "slice/slice_renderer.h"
 
 namespace lacuna::bench {
 
@@ -54,122 +53,132 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
         d.description = ds.description;
         d.tf_name = ds.tf_name;
         d.dims = vol.dims();
-        SliceRenderer slicer(vol);
-        slicer.set_transfer_function(ds.lut);
-        const auto t0 = std::chrono::steady_clock::now();
-        auto source = make_box_source(o.ess, vol, o.accel, o.boxes);
-        source->set_transfer_function(ds.lut);
-        d.source_ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3;
-        const std::vector<Camera> cams = orbit_cameras(slicer.bounds(), o.orbit);
-        if (const auto* gb = dynamic_cast<const GrowingBoxesSource*>(source.get())) {
-            const BoxesBuildStats& bs = gb->stats();
+        // Every column renders through one session: the ESS box source is built (and timed) by
+        // its first frame's prepare(), kept for the other columns, and the structures of the
+        // ray-marcher columns next to it.
+        Session session(vol, o.threads);  // shares the voxels
+        session.set_transfer_function(ds.tf);
+        FrameSpec base;
+        base.renderer = Renderer::Slicer;
+        base.structure = structure::None{};
+        base.sampling.step = o.step;
+        base.sampling.early_termination.reset();  // no per-pixel termination: the paper's GPU
+                                                  // has none
+        base.slicer.occlusion_threshold = o.threshold;
+        base.slicer.occlusion_map = o.map_size;
+        base.slicer.occlusion_updates = o.initial_updates;
+        const std::vector<FrameSpec> basic = orbit_frames(base, o.orbit);
+        // The ESS box source, by the name the slicer takes.
+        structure::GrowingBoxes gb;
+        gb.coalesce = o.boxes.coalesce;
+        gb.coalesce_edge = o.boxes.coalesce_edge;
+        FrameSpec ess = basic[0];
+        ess.structure = parse_structure(o.ess, Renderer::Slicer, o.accel, gb);
+        const FrameResult built = session.prepare(ess);  // validates: the slicer takes it
+        d.source_ms = (built.build_seconds + built.tf_sync_seconds) * 1e3;
+        const BoxSource* source = session.built_box_source(ess);
+        if (const auto* src = dynamic_cast<const GrowingBoxesSource*>(source)) {
+            const BoxesBuildStats& bs = src->stats();
             d.partition_ms = 1e3 * (bs.gradient + bs.grow + bs.measure + bs.ranges);
             d.bsp_ms = 1e3 * (bs.split + bs.merge);
         }
         if (log) log(ds.name + ": " + o.ess + " boxes built in " + fmt("%.1f", d.source_ms) + " ms");
 
+        // The orbit with the ESS boxes (or Basic's one box) and the occlusion settings.
+        auto frames = [&](bool boxes, bool occlusion, OcclusionUse use, bool adaptive) {
+            std::vector<FrameSpec> fs = basic;
+            for (FrameSpec& f : fs) {
+                if (boxes) f.structure = ess.structure;
+                f.slicer.occlusion = occlusion;
+                f.slicer.occlusion_use = use;
+                f.slicer.adaptive_updates = adaptive;
+            }
+            return fs;
+        };
         Image basic0, ess0, map0, cc0;
-        auto run = [&](const std::string& name, const BoxSource* src, OcclusionMode mode,
-                       bool adaptive, Image* first) {
+        auto run = [&](const std::string& name, const std::vector<FrameSpec>& fs, Image* first) {
             LiColumn col;
             col.name = name;
-            slicer.set_box_source(src);
-            AdaptiveOptions ao;
-            ao.initial = o.initial_updates;
-            AdaptiveUpdates controller(ao);
-            for (size_t v = 0; v < cams.size(); ++v) {
-                SliceOptions so;
-                so.step = o.step;
-                so.ert = kNoEarlyTermination;  // no per-pixel termination: the paper's GPU has none
-                so.threads = o.threads;
-                so.occlusion.mode = mode;
-                so.occlusion.threshold = o.threshold;
-                so.occlusion.map_size = o.map_size;
-                so.occlusion.updates = o.initial_updates;
+            for (size_t v = 0; v < fs.size(); ++v) {
                 const double cpu0 = cpu_now_ms();
-                SliceResult r = slicer.render(cams[v], so, adaptive ? &controller : nullptr);
+                FrameResult r = session.render(fs[v]);
                 col.cpu_ms += cpu_now_ms() - cpu0;
+                const SlicerFrameStats& st = *r.slicer;
                 col.frame_ms.push_back(r.stats.seconds * 1e3);
-                col.setup_fraction += r.stats.setup_cpu_fraction();
-                col.setup_wall += r.stats.setup_fraction();
-                col.culled += r.stats.culled_fraction();
-                col.clipped += r.stats.clipped_fraction();
+                col.setup_fraction += st.setup_cpu_fraction;
+                col.setup_wall += st.setup_fraction;
+                col.culled += st.culled_fraction;
+                col.clipped += st.clipped_fraction;
                 col.samples += double(r.stats.samples);
                 if (v == 0 && first) *first = std::move(r.image);
-                if (v == 0 && src) d.boxes = r.stats.boxes;
-                if (v == 0 && src)
-                    d.box_voxels = r.stats.voxels / (double(d.dims.x - 1) * (d.dims.y - 1) * (d.dims.z - 1));
+                const bool boxes = !std::holds_alternative<structure::None>(fs[v].structure);
+                if (v == 0 && boxes) d.boxes = st.boxes;
+                if (v == 0 && boxes)
+                    d.box_voxels = st.voxels / (double(d.dims.x - 1) * (d.dims.y - 1) * (d.dims.z - 1));
                 if (name == "ESS+CC") {
-                    d.desired_updates.push_back(r.stats.desired_updates);
-                    d.actual_updates.push_back(r.stats.map_updates);
+                    d.desired_updates.push_back(st.desired_updates);
+                    d.actual_updates.push_back(st.map_updates);
                 }
             }
             finish(col);
             if (log) log("  " + name + ": " + fmt("%.1f", col.mean_ms) + " ms/frame");
             d.columns.push_back(std::move(col));
         };
-        run("Basic", nullptr, OcclusionMode::Off, false, &basic0);
-        run("ESS", source.get(), OcclusionMode::Off, false, &ess0);
-        run("ESS+CC", source.get(), OcclusionMode::CullClip, true, &cc0);
-        run("ESS+M", source.get(), OcclusionMode::MapOnly, false, &map0);
-        run("ESS+C", source.get(), OcclusionMode::CullOnly, true, nullptr);
+        using U = OcclusionUse;
+        run("Basic", frames(false, false, U::CullClip, false), &basic0);
+        run("ESS", frames(true, false, U::CullClip, false), &ess0);
+        run("ESS+CC", frames(true, true, U::CullClip, true), &cc0);
+        run("ESS+M", frames(true, true, U::MapOnly, false), &map0);
+        run("ESS+C", frames(true, true, U::CullOnly, true), nullptr);
         d.ess_exact = basic0.rgba == ess0.rgba;
         d.map_only_exact = map0.rgba == ess0.rgba;
         for (size_t i = 0; i < cc0.rgba.size() && i < ess0.rgba.size(); ++i)
             d.max_cc_diff = std::max(d.max_cc_diff, std::abs(int(cc0.rgba[i]) - int(ess0.rgba[i])));
 
         if (o.march) {
-            RayMarcher m(vol);
-            m.set_transfer_function(ds.lut);
-            RenderOptions ro;
-            ro.step = o.step;
-            ro.ert = kNoEarlyTermination;
-            ro.threads = o.threads;
-            std::vector<std::pair<std::string, std::unique_ptr<Accel>>> accels;
-            accels.push_back({"march none", nullptr});
-            if (o.ess == "kdtree") {
-                auto kd = make_accel(AccelKind::KdTree, vol, o.accel);
-                kd->set_transfer_function(ds.lut);
-                accels.push_back({"march kdtree", std::move(kd)});
-            }
-            for (auto& [name, accel] : accels) {
-                m.set_accel(accel.get());
+            std::vector<std::pair<std::string, Structure>> marched;
+            marched.push_back({"march none", structure::None{}});
+            if (o.ess == "kdtree")
+                marched.push_back({"march kdtree", structure_of(AccelKind::KdTree, o.accel)});
+            for (const auto& [name, st] : marched) {
+                std::vector<FrameSpec> fs = basic;
+                for (FrameSpec& f : fs) {
+                    f.renderer = Renderer::RayMarcher;
+                    f.structure = st;
+                }
+                session.prepare(fs[0]);  // the kd-tree's build, outside the frame times
                 LiColumn col;
                 col.name = name;
                 const double cpu0 = cpu_now_ms();
-                const OrbitRun run_m = run_orbit(m, cams, ro);
+                const OrbitRun run_m = run_orbit(session, fs);
                 col.cpu_ms = cpu_now_ms() - cpu0;
                 for (double s : run_m.frame_seconds) col.frame_ms.push_back(s * 1e3);
                 col.samples = double(run_m.samples);
                 finish(col);
-                col.samples = double(run_m.samples) / double(std::max<size_t>(cams.size(), 1));
+                col.samples = double(run_m.samples) / double(std::max<size_t>(fs.size(), 1));
                 if (log) log("  " + name + ": " + fmt("%.1f", col.mean_ms) + " ms/frame");
                 d.columns.push_back(std::move(col));
             }
         }
         // Figure 6: a longer orbit of ESS+CC with the adaptive controller, first dataset only.
+        // The controller starts afresh: the frame before was another column's (ESS+C's culling
+        // only, or the ray marcher's).
         if (o.updates_views > 0 && rep.datasets.empty()) {
             OrbitSpec spec = o.orbit;
             spec.views = o.updates_views;
-            const std::vector<Camera> long_orbit = orbit_cameras(slicer.bounds(), spec);
-            slicer.set_box_source(source.get());
-            AdaptiveOptions ao;
-            ao.initial = o.initial_updates;
-            AdaptiveUpdates controller(ao);
+            std::vector<FrameSpec> long_orbit = orbit_frames(base, spec);
+            for (FrameSpec& f : long_orbit) {
+                f.structure = ess.structure;
+                f.slicer.occlusion = true;
+                f.slicer.occlusion_use = OcclusionUse::CullClip;
+                f.slicer.adaptive_updates = true;
+            }
             rep.figure6.dataset = ds.name;
-            for (const Camera& cam : long_orbit) {
-                SliceOptions so;
-                so.step = o.step;
-                so.ert = kNoEarlyTermination;
-                so.threads = o.threads;
-                so.occlusion.mode = OcclusionMode::CullClip;
-                so.occlusion.threshold = o.threshold;
-                so.occlusion.map_size = o.map_size;
-                so.occlusion.updates = o.initial_updates;
-                const SliceResult r = slicer.render(cam, so, &controller);
-                rep.figure6.desired.push_back(r.stats.desired_updates);
-                rep.figure6.actual.push_back(r.stats.map_updates);
-                rep.figure6.skipped.push_back(r.stats.skipped_fraction());
+            for (const FrameSpec& f : long_orbit) {
+                const FrameResult r = session.render(f);
+                rep.figure6.desired.push_back(r.slicer->desired_updates);
+                rep.figure6.actual.push_back(r.slicer->map_updates);
+                rep.figure6.skipped.push_back(r.slicer->skipped_fraction);
             }
             if (log)
                 log("  Figure 6: " + std::to_string(long_orbit.size()) + " ESS+CC frames");

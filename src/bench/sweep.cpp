@@ -10,7 +10,8 @@
 #include "accel/cell_ranges.h"
 #include "accel/octree.h"
 #include "lacuna/error.h"
-#include "lacuna/renderer.h"
+#include "lacuna/frame_spec.h"
+#include "lacuna/session.h"
 
 namespace lacuna::bench {
 
@@ -24,9 +25,10 @@ int octree_levels(const Volume& v, int leaf) {
     return p.levels;
 }
 
-// One sweep point: build the bitfield octree with `ao`, render the orbit, compare view 0.
-SweepPoint measure(const BenchDataset& d, RayMarcher& m, const std::vector<Camera>& cams,
-                   const RenderOptions& ro, const Image& reference, AccelOptions ao) {
+// One sweep point: the bitfield octree with `ao` built through the session (timed on its own),
+// the orbit rendered through it, view 0 compared with none's; then the octree is dropped.
+SweepPoint measure(const BenchDataset& d, Session& session, const std::vector<FrameSpec>& frames,
+                   const Image& reference, AccelOptions ao) {
     SweepPoint p;
     p.dataset = d.name;
     p.leaf = ao.leaf_cells;
@@ -34,14 +36,12 @@ SweepPoint measure(const BenchDataset& d, RayMarcher& m, const std::vector<Camer
     p.levels = octree_levels(*d.volume, ao.leaf_cells);
     p.initial_level = ao.initial_level;
     p.bidirectional = ao.bidirectional;
-    const auto t0 = std::chrono::steady_clock::now();
-    auto accel = make_accel(AccelKind::Bitfield, *d.volume, ao);
-    accel->set_transfer_function(d.lut);
-    p.generation_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    m.set_accel(accel.get());
-    OrbitRun run = run_orbit(m, cams, ro);
-    m.set_accel(nullptr);
+    std::vector<FrameSpec> fs = frames;
+    for (FrameSpec& f : fs) f.structure = structure_of(AccelKind::Bitfield, ao);
+    const FrameResult built = session.prepare(fs[0]);
+    p.generation_ms = (built.build_seconds + built.tf_sync_seconds) * 1e3;
+    OrbitRun run = run_orbit(session, fs);
+    session.drop_structures();
     std::vector<double> ms;
     for (double s : run.frame_seconds) ms.push_back(s * 1e3);
     p.frame_ms = summarize(ms);
@@ -107,23 +107,24 @@ SweepResult run_sweep(const std::vector<BenchDataset>& datasets, const SweepOpti
         throw Error("--sweep", "grid", "expected leaf sizes and bit widths");
     SweepResult res;
     res.options = o;
-    RenderOptions ro;
-    ro.step = o.step;
-    ro.ert = kNoEarlyTermination;  // Figures 4 and 6: early ray termination off
-    ro.threads = o.threads;
+    FrameSpec base;
+    base.structure = structure::None{};
+    base.sampling.step = o.step;
+    base.sampling.early_termination.reset();  // Figures 4 and 6: early ray termination off
     struct Setup {
-        std::unique_ptr<RayMarcher> marcher;
-        std::vector<Camera> cams;
+        std::unique_ptr<Session> session;
+        std::vector<FrameSpec> frames;
         Image reference;
     };
     std::vector<Setup> setups;
     for (const BenchDataset& d : datasets) {
         res.datasets.push_back(d.name);
         Setup s;
-        s.marcher = std::make_unique<RayMarcher>(*d.volume);
-        s.marcher->set_transfer_function(d.lut);
-        s.cams = orbit_cameras(s.marcher->bounds(), o.orbit);
-        RenderResult ref = s.marcher->render(s.cams[0], ro);
+        s.session = std::make_unique<Session>(*d.volume, o.threads);  // shares the voxels
+        s.session->set_transfer_function(d.tf);
+        s.frames = orbit_frames(base, o.orbit);
+        FrameResult ref = s.session->render(s.frames[0]);
+        s.session->drop_structures();
         res.none_ms.push_back(ref.stats.seconds * 1e3);
         s.reference = std::move(ref.image);
         if (log)
@@ -139,7 +140,7 @@ SweepResult run_sweep(const std::vector<BenchDataset>& datasets, const SweepOpti
                 ao.leaf_cells = leaf;
                 ao.bitfield_bits = bits;
                 ao.threads = o.threads;
-                res.leaf_bits.push_back(measure(datasets[i], *setups[i].marcher, setups[i].cams, ro,
+                res.leaf_bits.push_back(measure(datasets[i], *setups[i].session, setups[i].frames,
                                                 setups[i].reference, ao));
                 log_point(log, res.leaf_bits.back());
             }
@@ -162,7 +163,7 @@ SweepResult run_sweep(const std::vector<BenchDataset>& datasets, const SweepOpti
                 ao.initial_level = level;
                 ao.bidirectional = bidirectional;
                 ao.threads = o.threads;
-                res.levels.push_back(measure(datasets[i], *setups[i].marcher, setups[i].cams, ro,
+                res.levels.push_back(measure(datasets[i], *setups[i].session, setups[i].frames,
                                              setups[i].reference, ao));
                 log_point(log, res.levels.back());
             }

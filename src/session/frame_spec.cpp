@@ -300,6 +300,8 @@ void validate(const FrameSpec& s) {
             fail("slicer.occlusion_threshold", "expected 0 < T <= 1");
         if (s.slicer.occlusion_map < 1 || s.slicer.occlusion_map > 4096)
             fail("slicer.occlusion_map", "expected 1..4096 cells");
+        if (s.slicer.occlusion_updates < 0)
+            fail("slicer.occlusion_updates", "expected >= 0 map updates per frame");
     }
     if (s.renderer == Renderer::Segments && !(s.segments.tint >= 0.f && s.segments.tint <= 1.f))
         fail("segments.tint", "expected a number in [0,1]");

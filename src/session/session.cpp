@@ -64,6 +64,15 @@ struct Session::State {
     std::vector<BuiltSource> sources;
     std::vector<BuiltSegments> segments;
     SegmentRenderer* current_segments = nullptr;  // the one prepare() set up for the frame
+
+    // The slicer's adaptive map updates (SlicerSpec::adaptive_updates): the controller and the
+    // frames it learns from (their structure and slicer spec). Any other frame drops it.
+    struct Adaptive {
+        Structure structure;
+        SlicerSpec slicer;
+        AdaptiveUpdates controller;
+    };
+    std::optional<Adaptive> adaptive;
 };
 
 Session::Session(Volume volume, int threads)
@@ -321,9 +330,14 @@ SliceOptions slice_options(const FrameSpec& spec, int threads) {
     o.nearest = spec.sampling.interpolation == Interpolation::Nearest;
     o.keep_float = spec.keep_float;
     if (spec.slicer.occlusion) {
-        o.occlusion.mode = OcclusionMode::CullClip;
+        switch (spec.slicer.occlusion_use) {
+            case OcclusionUse::CullClip: o.occlusion.mode = OcclusionMode::CullClip; break;
+            case OcclusionUse::CullOnly: o.occlusion.mode = OcclusionMode::CullOnly; break;
+            case OcclusionUse::MapOnly: o.occlusion.mode = OcclusionMode::MapOnly; break;
+        }
         o.occlusion.threshold = spec.slicer.occlusion_threshold;
         o.occlusion.map_size = spec.slicer.occlusion_map;
+        o.occlusion.updates = spec.slicer.occlusion_updates;
     }
     return o;
 }
@@ -342,6 +356,7 @@ SlicerFrameStats slicer_stats(const SliceStats& st) {
     fs.culled_fraction = st.culled_fraction();
     fs.clipped_fraction = st.clipped_fraction();
     fs.occlusion_seconds = st.occlusion_seconds;
+    fs.voxels = st.voxels;
     return fs;
 }
 
@@ -351,13 +366,27 @@ FrameResult Session::render(const FrameSpec& spec) {
     FrameResult out = prepare(spec);
     State& s = *m_state;
     const Camera cam = camera(spec);
+    if (!(spec.renderer == Renderer::Slicer && spec.slicer.occlusion && spec.slicer.adaptive_updates))
+        s.adaptive.reset();
     RenderResult r;
     switch (spec.renderer) {
         case Renderer::RayMarcher:
             r = s.marcher->render(cam, render_options(spec, m_threads));
             break;
         case Renderer::Slicer: {
-            SliceResult sr = s.slicer->render(cam, slice_options(spec, m_threads));
+            // The adaptive controller learns over consecutive frames of one structure and
+            // slicer spec (the camera moves); a frame of another starts it afresh.
+            AdaptiveUpdates* adaptive = nullptr;
+            if (spec.slicer.occlusion && spec.slicer.adaptive_updates) {
+                if (!s.adaptive || !(s.adaptive->structure == spec.structure) ||
+                    !(s.adaptive->slicer == spec.slicer)) {
+                    AdaptiveOptions ao;
+                    ao.initial = spec.slicer.occlusion_updates;
+                    s.adaptive.emplace(State::Adaptive{spec.structure, spec.slicer, AdaptiveUpdates(ao)});
+                }
+                adaptive = &s.adaptive->controller;
+            }
+            SliceResult sr = s.slicer->render(cam, slice_options(spec, m_threads), adaptive);
             r.image = std::move(sr.image);
             r.rgba_float = std::move(sr.rgba_float);
             r.stats.seconds = sr.stats.seconds;
@@ -393,8 +422,28 @@ void Session::drop_structures() {
     m_state->sources.clear();
     m_state->segments.clear();
     m_state->current_segments = nullptr;
+    m_state->adaptive.reset();
     if (m_state->marcher) m_state->marcher->set_accel(nullptr);
     if (m_state->slicer) m_state->slicer->set_box_source(nullptr);
+}
+
+const Accel* Session::built_structure(const FrameSpec& spec) const {
+    const bool marched = spec.renderer == Renderer::RayMarcher ||
+                         (spec.renderer == Renderer::Segments &&
+                          spec.segments.mode == SegmentMode::Masked &&
+                          !std::holds_alternative<structure::LabelOctree>(spec.structure));
+    if (!marched) return nullptr;
+    for (const auto& b : m_state->accels)
+        if (b.structure == spec.structure && b.interpolation == spec.sampling.interpolation)
+            return b.accel.get();
+    return nullptr;
+}
+
+const BoxSource* Session::built_box_source(const FrameSpec& spec) const {
+    if (spec.renderer != Renderer::Slicer) return nullptr;
+    for (const auto& b : m_state->sources)
+        if (b.structure == spec.structure) return b.source.get();
+    return nullptr;
 }
 
 size_t Session::built_count() const {

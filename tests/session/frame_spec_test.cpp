@@ -121,6 +121,8 @@ TEST(FrameSpec, EachErrorNamesItsField) {
         {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_threshold = 0.f; },
          "slicer.occlusion_threshold"},
         {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_map = 5000; }, "slicer.occlusion_map"},
+        {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_updates = -1; },
+         "slicer.occlusion_updates"},
         {Renderer::Segments, [](FrameSpec& f) { f.segments.tint = 2.f; }, "segments.tint"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.features.phong.power = -1.f; }, "features.phong"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.features.pbr.roughness = 0.f; }, "features.pbr"},

@@ -158,6 +158,87 @@ TEST(Session, SlicerFramesAreTheHandWiredFrames) {
     }
 }
 
+// The slicer's occlusion uses and the adaptive map updates through the session are the slicer
+// driven by hand over an orbit: images, samples and the updates per frame. The adaptive
+// controller learns over consecutive frames of one structure and slicer spec; a frame of another
+// spec in between starts it afresh (what bench li's columns rely on).
+TEST(Session, SlicerOcclusionFramesAreTheHandWiredFramesAcrossAnOrbit) {
+    const Volume vol = blobs();
+    const TransferFunction tf = window(0.3, 0.7);  // opaque blobs: boxes behind them hide
+    const TransferLut lut = discretise(tf, vol.vis_range());
+    Session session(blobs(), 1);
+    session.set_transfer_function(tf);
+    AccelOptions ao;
+    ao.threads = 1;
+    auto source = make_box_source("kdtree", vol, ao);
+    source->set_transfer_function(lut);
+    SliceRenderer slicer(vol);
+    slicer.set_transfer_function(lut);
+    slicer.set_box_source(source.get());
+    const std::pair<OcclusionUse, OcclusionMode> uses[] = {
+        {OcclusionUse::CullClip, OcclusionMode::CullClip},
+        {OcclusionUse::CullOnly, OcclusionMode::CullOnly},
+        {OcclusionUse::MapOnly, OcclusionMode::MapOnly}};
+    for (bool adaptive : {false, true})
+        for (const auto& [use, mode] : uses) {
+            AdaptiveOptions aopt;
+            aopt.initial = 3;
+            AdaptiveUpdates controller(aopt);
+            int updates_seen = 0;
+            for (int view = 0; view < 4; ++view) {
+                FrameSpec f = spec(structure::KdTree{});
+                f.renderer = Renderer::Slicer;
+                f.camera.orbit.azimuth_deg = 90.f * float(view);
+                f.slicer.occlusion = true;
+                f.slicer.occlusion_use = use;
+                f.slicer.occlusion_updates = 3;
+                f.slicer.occlusion_map = 16;
+                f.slicer.adaptive_updates = adaptive;
+                SliceOptions o;
+                o.step = f.sampling.step;
+                o.ert = *f.sampling.early_termination;
+                o.threads = 1;
+                o.occlusion.mode = mode;
+                o.occlusion.updates = 3;
+                o.occlusion.map_size = 16;
+                const Camera cam = Camera::orbit(slicer.bounds(), f.camera.orbit, f.width, f.height);
+                const SliceResult hand = slicer.render(cam, o, adaptive ? &controller : nullptr);
+                const FrameResult r = session.render(f);
+                const std::string what = to_string(mode) + (adaptive ? " adaptive" : "") +
+                                         " view " + std::to_string(view);
+                EXPECT_TRUE(r.image.rgba == hand.image.rgba) << what;
+                EXPECT_EQ(r.stats.samples, hand.stats.samples) << what;
+                ASSERT_TRUE(r.slicer.has_value());
+                EXPECT_EQ(r.slicer->desired_updates, hand.stats.desired_updates) << what;
+                EXPECT_EQ(r.slicer->map_updates, hand.stats.map_updates) << what;
+                EXPECT_DOUBLE_EQ(r.slicer->voxels, hand.stats.voxels) << what;
+                updates_seen += hand.stats.map_updates;
+            }
+            EXPECT_GT(updates_seen, 0) << to_string(mode);  // the map was in use
+        }
+    // Frames of another slicer spec in between: the next adaptive frame starts from a fresh
+    // controller, as a fresh session would.
+    FrameSpec f = spec(structure::KdTree{});
+    f.renderer = Renderer::Slicer;
+    f.slicer.occlusion = true;
+    f.slicer.adaptive_updates = true;
+    f.slicer.occlusion_updates = 2;
+    Session fresh(blobs(), 1);
+    fresh.set_transfer_function(tf);
+    for (int view = 0; view < 12; ++view) {
+        f.camera.orbit.azimuth_deg = 30.f * float(view);
+        session.render(f);
+    }
+    FrameSpec other = f;
+    other.slicer.occlusion_use = OcclusionUse::CullOnly;
+    session.render(other);
+    for (int view = 0; view < 12; ++view) {
+        f.camera.orbit.azimuth_deg = 30.f * float(view);
+        EXPECT_EQ(session.render(f).slicer->desired_updates, fresh.render(f).slicer->desired_updates)
+            << view;
+    }
+}
+
 TEST(Session, SegmentFramesAreTheHandWiredFrames) {
     const Volume vol = blobs(), labels = label_blobs();
     const TransferLut lut = discretise(window(0.2, 0.8), vol.vis_range());
