@@ -246,11 +246,10 @@ void run(const PartitionArgs& a) {
     t.list = median(&KdTimings::list);
 
     // The default view: the overlay's camera; boxes front to back for its eye.
-    RayMarcher marcher(vol);
     OrbitParams op;
     op.azimuth_deg = a.azimuth;
     op.elevation_deg = a.elevation;
-    const Camera cam = Camera::orbit(marcher.bounds(), op, a.size, a.size);  // world (RAS)
+    const Camera cam = Camera::orbit(world_bounds(vol), op, a.size, a.size);  // world (RAS)
     // The boxes live in the RAS-order copy's volume frame (index * spacing): project and order
     // them there.
     const Camera vcam = to_volume_frame(volume_frame(ras), cam);
