@@ -24,6 +24,7 @@
 #include "lacuna/image.h"
 #include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
+#include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
 #include "partition_boxes.h"
 #include "partition_frame.h"
@@ -328,15 +329,16 @@ void run(const PartitionArgs& a) {
     }
 
     if (!a.out.empty()) {
-        // The picture is rendered with the TF (exactly, skipping with the TF's own kd-tree).
-        AccelOptions render_ao = ao;
-        auto accel = make_accel(AccelKind::KdTree, vol, render_ao);
-        accel->set_transfer_function(lut);
-        marcher.set_transfer_function(lut);
-        marcher.set_accel(accel.get());
-        RenderOptions ro;
-        ro.threads = a.threads;
-        RenderResult r = marcher.render(cam, ro);
+        // The picture is rendered with the TF (exactly, skipping with the TF's own kd-tree),
+        // through a Session as every front end's frame (it shares the voxels): the view is the
+        // overlay's camera, Camera::orbit of the volume's world bounds.
+        Session session(vol, a.threads);
+        session.set_transfer_function(tf);
+        FrameSpec frame;
+        frame.structure = structure_of(AccelKind::KdTree, ao);
+        frame.camera.orbit = op;
+        frame.width = frame.height = a.size;
+        FrameResult r = session.render(frame);
         const Projector proj(vcam);
         const int w = a.size >= 384 ? 2 : 1;
         for (size_t i = 0; i < boxes.size(); ++i)
