@@ -660,6 +660,31 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define LACUNA_AVX512 __attribute__((target("avx512f")))
 
+// The corner-pair rows of sixteen cells at voxel offsets `ofs` into w[row][lane]: row r holds the
+// pair (i, i + 1) at (j + (r & 1), k + (r >> 1)); a Word is two voxels (uint16_t for bytes,
+// int32_t for 16-bit voxels). kSparse: only the `live` lanes load, the others read 0.
+template <class Word, class T>
+LACUNA_AVX512 inline __attribute__((always_inline)) void load_pair_rows(const T* p, int l, ptrdiff_t psy,
+                                                                   ptrdiff_t psz, Word (*w)[16]) {
+    __builtin_memcpy(&w[0][l], p, sizeof(Word));
+    __builtin_memcpy(&w[1][l], p + psy, sizeof(Word));
+    __builtin_memcpy(&w[2][l], p + psz, sizeof(Word));
+    __builtin_memcpy(&w[3][l], p + psy + psz, sizeof(Word));
+}
+template <bool kSparse, class Word, class T>
+LACUNA_AVX512 inline __attribute__((always_inline)) void corner_pairs16(const T* data, const int32_t* ofs,
+                                                                   __mmask16 live, ptrdiff_t psy,
+                                                                   ptrdiff_t psz, Word (*w)[16]) {
+    if constexpr (kSparse) {
+        for (size_t b = 0; b < sizeof(Word) * 4 * 16; b += 64)
+            _mm512_store_si512(reinterpret_cast<char*>(w) + b, _mm512_setzero_si512());
+        for (unsigned mk = live; mk; mk &= mk - 1)
+            load_pair_rows(data + ofs[__builtin_ctz(mk)], __builtin_ctz(mk), psy, psz, w);
+    } else {
+        for (int l = 0; l < 16; ++l) load_pair_rows(data + ofs[l], l, psy, psz, w);
+    }
+}
+
 // Trilinear values at sixteen index-space points already clamped into [0, hi] (trilinear8's
 // operations in its order); lanes outside `live` read voxel 0's cell, their values unused. G has
 // cell[3], sy, sz. kSparse (integer voxels): only the `live` lanes load their corners, one by
@@ -686,27 +711,7 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
         alignas(64) int32_t ofs[16];
         alignas(64) uint16_t wp[4][16];
         _mm512_store_si512(ofs, off);
-        const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-        if constexpr (kSparse) {
-            _mm512_store_si512(wp[0], _mm512_setzero_si512());
-            _mm512_store_si512(wp[2], _mm512_setzero_si512());
-            for (unsigned mk = live; mk; mk &= mk - 1) {
-                const int l = __builtin_ctz(mk);
-                const T* p = data + ofs[l];
-                __builtin_memcpy(&wp[0][l], p, 2);
-                __builtin_memcpy(&wp[1][l], p + psy, 2);
-                __builtin_memcpy(&wp[2][l], p + psz, 2);
-                __builtin_memcpy(&wp[3][l], p + psyz, 2);
-            }
-        } else {
-            for (int l = 0; l < 16; ++l) {
-                const T* p = data + ofs[l];
-                __builtin_memcpy(&wp[0][l], p, 2);
-                __builtin_memcpy(&wp[1][l], p + psy, 2);
-                __builtin_memcpy(&wp[2][l], p + psz, 2);
-                __builtin_memcpy(&wp[3][l], p + psyz, 2);
-            }
-        }
+        corner_pairs16<kSparse>(data, ofs, live, g.sy, g.sz, wp);
         const __m512i m = _mm512_set1_epi32(0xff);
         const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
         const __m512i w1 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
@@ -725,26 +730,7 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
         alignas(64) int32_t ofs[16];
         alignas(64) int32_t wq[4][16];
         _mm512_store_si512(ofs, off);
-        const ptrdiff_t psy = g.sy, psz = g.sz, psyz = psy + psz;
-        if constexpr (kSparse) {
-            for (int i = 0; i < 4; ++i) _mm512_store_si512(wq[i], _mm512_setzero_si512());
-            for (unsigned mk = live; mk; mk &= mk - 1) {
-                const int l = __builtin_ctz(mk);
-                const T* p = data + ofs[l];
-                __builtin_memcpy(&wq[0][l], p, 4);
-                __builtin_memcpy(&wq[1][l], p + psy, 4);
-                __builtin_memcpy(&wq[2][l], p + psz, 4);
-                __builtin_memcpy(&wq[3][l], p + psyz, 4);
-            }
-        } else {
-            for (int l = 0; l < 16; ++l) {
-                const T* p = data + ofs[l];
-                __builtin_memcpy(&wq[0][l], p, 4);
-                __builtin_memcpy(&wq[1][l], p + psy, 4);
-                __builtin_memcpy(&wq[2][l], p + psz, 4);
-                __builtin_memcpy(&wq[3][l], p + psyz, 4);
-            }
-        }
+        corner_pairs16<kSparse>(data, ofs, live, g.sy, g.sz, wq);
         const __m512i w0 = _mm512_load_si512(wq[0]), w1 = _mm512_load_si512(wq[1]);
         const __m512i w2 = _mm512_load_si512(wq[2]), w3 = _mm512_load_si512(wq[3]);
         if constexpr (std::is_signed_v<T>) {
