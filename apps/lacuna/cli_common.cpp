@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -105,25 +106,47 @@ Vec3i parse_dims(const std::string& s, const std::string& where) {
     return d;
 }
 
-Volume load_volume(const VolumeArgs& a) {
-    ReadOptions ro;
+ValueRange parse_range(const std::string& range) {
+    const size_t c = range.find(':');
+    if (c == std::string::npos) throw Error("--range", "range", "expected MIN:MAX, got '" + range + "'");
+    try {
+        size_t used = 0;
+        const float lo = std::stof(range.substr(0, c), &used);
+        if (used != c) throw std::invalid_argument("x");
+        const std::string rest = range.substr(c + 1);
+        const float hi = std::stof(rest, &used);
+        if (used != rest.size()) throw std::invalid_argument("x");
+        return {lo, hi};
+    } catch (const std::logic_error&) {
+        throw Error("--range", "range", "expected MIN:MAX numbers, got '" + range + "'");
+    }
+}
+
+std::optional<RawSpec> raw_spec_of(const VolumeArgs& a) {
+    std::optional<RawSpec> raw;
     if (!a.raw_dims.empty() || !a.raw_type.empty()) {
         RawSpec spec;
         if (a.raw_dims.empty() || a.raw_type.empty())
             throw Error("--dims/--type", "raw layout", "give both --dims and --type for a raw file");
         spec.dims = parse_dims(a.raw_dims, "--dims");
         spec.type = parse_voxel_type(a.raw_type, "--type");
-        ro.raw = spec;
+        raw = spec;
     }
     if (!a.spacing.empty()) {
         // A raw file's layout comes from --dims/--type or its name; --spacing completes either.
-        if (!ro.raw) ro.raw = raw_spec_from_name(a.path);
-        if (!ro.raw || std::filesystem::path(a.path).extension() != ".raw")
+        if (!raw) raw = raw_spec_from_name(a.path);
+        if (!raw || std::filesystem::path(a.path).extension() != ".raw")
             throw Error("--spacing", "spacing",
                         "applies to .raw files (other formats carry their own spacing); for a raw "
                         "file give --dims and --type or a name like head_181x217x181_uint8.raw");
-        ro.raw->spacing = parse_spacing(a.spacing, "--spacing");
+        raw->spacing = parse_spacing(a.spacing, "--spacing");
     }
+    return raw;
+}
+
+Volume load_volume(const VolumeArgs& a) {
+    ReadOptions ro;
+    ro.raw = a.raw_spec ? a.raw_spec : raw_spec_of(a);
     ro.frame = a.frame;
     if (!a.max_memory.empty()) ro.max_memory.bytes = parse_bytes(a.max_memory, "--max-memory");
     ro.max_memory.name = "--max-memory";
@@ -132,23 +155,12 @@ Volume load_volume(const VolumeArgs& a) {
     ro.progress = [&](double f) { progress.update(f); };
     Volume v = read_volume(a.path, ro);
     progress.done();
-    if (!a.range.empty()) {
-        size_t c = a.range.find(':');
-        if (c == std::string::npos) throw Error("--range", "range", "expected MIN:MAX, got '" + a.range + "'");
+    if (a.range_value || !a.range.empty()) {
+        const ValueRange r = a.range_value ? *a.range_value : parse_range(a.range);
         try {
-            size_t used = 0;
-            float lo = std::stof(a.range.substr(0, c), &used);
-            if (used != c) throw std::invalid_argument("x");
-            std::string rest = a.range.substr(c + 1);
-            float hi = std::stof(rest, &used);
-            if (used != rest.size()) throw std::invalid_argument("x");
-            try {
-                v.set_vis_range({lo, hi});
-            } catch (const Error& e) {  // the library names the field; the user typed --range
-                throw Error(std::string("--range: ") + e.what());
-            }
-        } catch (const std::logic_error&) {
-            throw Error("--range", "range", "expected MIN:MAX numbers, got '" + a.range + "'");
+            v.set_vis_range(r);
+        } catch (const Error& e) {  // the library names the field; the user typed --range
+            throw Error(std::string("--range: ") + e.what());
         }
     }
     return v;
@@ -167,25 +179,98 @@ void check_output_path(const std::string& path, const std::string& ext) {
     if (fs::is_directory(p, ec)) throw Error(path, "output", "is a folder");
 }
 
+namespace {
+bool g_quiet = false;
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string plural(int64_t n, const std::string& unit) {
+    return std::to_string(n) + " " + unit + (n == 1 ? "" : "s");
+}
+}  // namespace
+
+void set_quiet(bool q) { g_quiet = q; }
+bool quiet() { return g_quiet; }
+
 Progress::Progress(std::string what)
-    : m_what(std::move(what)), m_tty(::isatty(2)), m_start(std::chrono::steady_clock::now()) {
-    if (m_tty) std::fprintf(stderr, "%s ...", m_what.c_str());
+    : m_what(std::move(what)), m_tty(::isatty(2) && !g_quiet),
+      m_start(std::chrono::steady_clock::now()), m_last_draw(m_start) {
+    draw(m_what + " ...", true);
+}
+
+Progress::Progress(std::string what, int64_t total, std::string unit)
+    : m_what(std::move(what)), m_unit(std::move(unit)), m_total(std::max<int64_t>(total, 0)),
+      m_tty(::isatty(2) && !g_quiet), m_start(std::chrono::steady_clock::now()),
+      m_last_draw(m_start) {}
+
+// A terminal line, redrawn at most ten times a second unless `force`; padded so a shorter line
+// covers a longer one.
+void Progress::draw(const std::string& line, bool force) {
+    if (!m_tty || m_done) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!force && now - m_last_draw < std::chrono::milliseconds(100)) return;
+    m_last_draw = now;
+    std::fprintf(stderr, "\r%-60s", line.c_str());
+    std::fflush(stderr);
+    m_drawn = true;
 }
 
 void Progress::update(double f) {
-    if (m_tty && !m_done) std::fprintf(stderr, "\r%s ... %3d%%", m_what.c_str(), int(f * 100 + 0.5));
+    char pct[16];
+    std::snprintf(pct, sizeof pct, "%3d%%", int(f * 100 + 0.5));
+    draw(m_what + " ... " + pct, false);
+}
+
+void Progress::step(int64_t items_done) {
+    m_items = items_done;
+    if (m_total <= 0) return;
+    const double s = seconds_since(m_start);
+    char line[160];
+    if (items_done > 0 && items_done < m_total)
+        std::snprintf(line, sizeof line, "%s: %lld/%lld %ss, %.1f s, ETA %.1f s", m_what.c_str(),
+                      (long long)items_done, (long long)m_total, m_unit.c_str(), s,
+                      s / double(items_done) * double(m_total - items_done));
+    else
+        std::snprintf(line, sizeof line, "%s: %lld/%lld %ss, %.1f s", m_what.c_str(),
+                      (long long)items_done, (long long)m_total, m_unit.c_str(), s);
+    // The first count is drawn at once (the line appears), the last one too (it is complete).
+    draw(line, !m_drawn || items_done == m_total);
 }
 
 void Progress::done() {
     if (m_done) return;
+    const double s = seconds_since(m_start);
+    char line[200];
+    if (m_total < 0) {  // a fraction: the terminal's last word on the step
+        std::snprintf(line, sizeof line, "%s ... done in %.2f s", m_what.c_str(), s);
+        draw(line, true);
+        if (m_tty) std::fprintf(stderr, "\n");
+        m_done = true;
+        return;
+    }
+    if (m_total == 0)
+        std::snprintf(line, sizeof line, "%s: done in %.2f s", m_what.c_str(), s);
+    else if (m_total == 1)
+        std::snprintf(line, sizeof line, "%s: %s in %.2f s", m_what.c_str(),
+                      plural(m_total, m_unit).c_str(), s);
+    else
+        std::snprintf(line, sizeof line, "%s: %s in %.2f s (%.1f ms/%s)", m_what.c_str(),
+                      plural(m_total, m_unit).c_str(), s, s * 1e3 / double(m_total),
+                      m_unit.c_str());
+    if (m_tty) {
+        draw(line, true);
+        std::fprintf(stderr, "\n");
+    } else if (!g_quiet) {
+        std::fprintf(stderr, "%s\n", line);
+    }
     m_done = true;
-    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
-    if (m_tty) std::fprintf(stderr, "\r%s ... done in %.2f s\n", m_what.c_str(), s);
 }
 
 Progress::~Progress() {
     // Abandoned on an exception: end the line so the error message starts cleanly.
-    if (m_tty && !m_done) std::fprintf(stderr, "\n");
+    if (m_drawn && !m_done) std::fprintf(stderr, "\n");
 }
 
 void parse_view(const std::string& name, float& azimuth, float& elevation) {

@@ -265,7 +265,7 @@ void register_bench(CLI::App& app) {
     f->callback([a, f] {
         a->size_given = f->count("--size") > 0;
         a->views_given = f->count("--views") > 0;
-        run_faludi(*a);
+        with_summary("bench faludi", [&] { run_faludi(*a); });
     });
 }
 

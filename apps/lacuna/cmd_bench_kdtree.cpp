@@ -138,7 +138,7 @@ void register_bench_kdtree(CLI::App& bench) {
             if (!k->count("--views")) args.views = 1;
             if (!k->count("--repeat")) args.repeat = 1;
         }
-        run_kdtree_bench(args);
+        with_summary("bench kdtree", [&] { run_kdtree_bench(args); });
     });
 }
 

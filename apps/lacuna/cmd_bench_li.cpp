@@ -120,7 +120,7 @@ void register_bench_li(CLI::App& bench) {
         ->capture_default_str();
     c->add_option("--templates", a->templates, "Folder of the mricron templates")
         ->capture_default_str();
-    c->callback([a] { run_li(*a); });
+    c->callback([a] { with_summary("bench li", [&] { run_li(*a); }); });
 }
 
 }  // namespace lacuna::cli

@@ -217,7 +217,7 @@ void register_bench_vtk(CLI::App& bench) {
         a->sizes_given = c->count("--sizes") > 0;
         a->rounds_given = c->count("--rounds") > 0;
         a->frames_given = c->count("--frames") > 0;
-        run_vtk(*a);
+        with_summary("bench vtk", [&] { run_vtk(*a); });
     });
 }
 

@@ -21,11 +21,14 @@ void run(const GenerateArgs& a) {
     so.type = parse_voxel_type(a.type, "--type");
     so.seed = a.seed;
     if (a.out.empty()) throw Error("generate", "--out", "expected an output volume file");
+    Progress summary("generate", 0, "");
     Progress progress("generating " + a.kind);
     const Volume v = generate(kind, so);
     progress.done();
     write_volume(a.out, v);
     std::printf("wrote %s: %s\n", a.out.c_str(), to_string(v).c_str());
+    std::fflush(stdout);
+    summary.done();
 }
 
 }  // namespace

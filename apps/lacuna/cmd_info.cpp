@@ -12,6 +12,7 @@ namespace lacuna::cli {
 namespace {
 
 void run(const VolumeArgs& args) {
+    Progress summary("info", 0, "");
     const Volume v = load_volume(args);
     const Vec3i d = v.dims();
     std::printf("file:        %s\n", args.path.c_str());
@@ -68,6 +69,8 @@ void run(const VolumeArgs& args) {
         std::printf("  %10.4g  %5.1f%%  %s\n", lo, 100.0 * double(hist[b]) / n,
                     std::string(size_t(bar), '#').c_str());
     }
+    std::fflush(stdout);
+    summary.done();
 }
 
 }  // namespace

@@ -414,7 +414,10 @@ void register_partition(CLI::App& app) {
                             "sets the azimuth and elevation; drop --azimuth/--elevation");
             parse_view(a->view, a->azimuth, a->elevation);
         }
+        Progress summary("partition", 0, "");
         run(*a);
+        std::fflush(stdout);
+        summary.done();
     });
 }
 

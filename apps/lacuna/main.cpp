@@ -2,8 +2,6 @@
 // code 2; usage errors exit 2 as well (docs/cli.md).
 #include <algorithm>
 #include <cstdio>
-
-#include "frame_flags.h"
 #include <exception>
 #include <iostream>
 #include <string>
@@ -47,6 +45,14 @@ void check_subcommand(const CLI::App& app, int argc, char** argv) {
                         "; expected one of: " + names);
 }
 
+// --quiet on the app and on every subcommand, so both `lacuna --quiet render ...` and
+// `lacuna render ... --quiet` work (cli_common.h: progress and summaries, never errors).
+void add_quiet(CLI::App& app) {
+    app.add_flag_callback("--quiet,-q", [] { lacuna::cli::set_quiet(true); },
+                          "No progress lines or summaries on stderr (errors are still printed)");
+    for (CLI::App* s : app.get_subcommands([](const CLI::App*) { return true; })) add_quiet(*s);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,6 +65,7 @@ int main(int argc, char** argv) {
     lacuna::cli::register_bench(app);
     lacuna::cli::register_partition(app);
     lacuna::cli::register_serve(app);
+    add_quiet(app);
     try {
         check_subcommand(app, argc, argv);
         app.parse(argc, argv);
