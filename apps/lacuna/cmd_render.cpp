@@ -1,6 +1,7 @@
-// `lacuna render`: one frame of a volume to a PNG, with timing and sample statistics; or, with
-// --tf-animate, a sequence while the TF moves between two TFs (bitfield paper, Section 4.5),
-// reporting per structure the time from a TF change to ready-to-render.
+// `lacuna render`: one frame of a volume to a PNG, with timing and sample statistics; with
+// --orbit N, N frames around the volume; or, with --tf-animate, a sequence while the TF moves
+// between two TFs (bitfield paper, Section 4.5), reporting per structure the time from a TF change
+// to ready-to-render. Sequences are numbered PNGs (frame_path) and, with --movie, an MP4 (movie.h).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +17,9 @@
 #include "lacuna/frame_spec.h"
 #include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
+#include "movie.h"
+#include "io/io_util.h"
+#include "session/session_file.h"
 #include "render_slice.h"
 #include "segments_cli.h"
 
@@ -35,6 +39,13 @@ struct RenderArgs {
     std::string tf;
     std::vector<std::string> tf_animate;
     int frames = 36;
+    int orbit = 0;      // --orbit N: N frames around the orbit (0: one frame)
+    std::string movie;  // --movie out.mp4: the sequence as an H.264 MP4 too
+    int fps = 24;
+    std::string session;       // --session FILE: the frame a session file describes
+    std::string save_session;  // --save-session FILE: write the command line's frame as one
+    // The TFs a session file holds (instead of resolving --tf / --tf-back).
+    std::optional<TransferFunction> tf_value, tf_back_value;
     int repeat = 1;  // --repeat: the same frame this many times (warm frames, median reported)
     bool no_refine = false;  // --no-refine: frames without the structure's finer per-TF level
     std::string accel = "auto";  // default_accel() for the ray marcher (docs/cli.md)
@@ -79,14 +90,21 @@ std::vector<AccelKind> parse_accels(const std::string& s) {
     return out;
 }
 
-// Frame i of an animation written beside `out`: head.png -> head_007.png.
-std::string frame_path(const std::string& out, int i) {
+// Frame i of a sequence of n (--orbit, --tf-animate) written beside `out`: head.png ->
+// head_0007.png. One rule for both: the number has four digits, or as many as n - 1 has when that
+// is more, so the names sort in frame order and ffmpeg's "%04d" pattern reads them.
+std::string frame_path(const std::string& out, int i, int n) {
     namespace fs = std::filesystem;
     fs::path p(out);
-    char num[16];
-    std::snprintf(num, sizeof num, "_%03d", i);
+    const int digits = std::max<int>(4, int(std::to_string(std::max(n - 1, 0)).size()));
+    char num[24];
+    std::snprintf(num, sizeof num, "_%0*d", digits, i);
     return (p.parent_path() / (p.stem().string() + num + p.extension().string())).string();
 }
+
+// The azimuth of orbit frame i of n: the start plus i/n of a turn, in float as the single-frame
+// --azimuth is, so frame i is byte for byte `render --azimuth <that value>`.
+float orbit_azimuth(float start, int i, int n) { return start + 360.f * float(i) / float(n); }
 
 // The frame the flags describe (the strings become a FrameSpec here; its ranges are checked by
 // lacuna::validate, whose fields frame_flags.cpp translates back to flags).
@@ -102,7 +120,90 @@ Structure structure_from(const std::string& name, const RenderArgs& a, const Set
                            structure::GrowingBoxes{a.slice.coalesce, a.slice.coalesce_edge});
 }
 
+// The outputs and sequence flags, for frames from flags and from a session file alike.
+void check_outputs(const RenderArgs& a) {
+    const bool sequence = a.orbit != 0 || !a.tf_animate.empty();
+    if (a.orbit < 0 || a.orbit > 100000) throw Error("--orbit", "frames", "expected 1..100000");
+    if (a.orbit && !a.tf_animate.empty())
+        throw Error("--orbit", "frames", "not with --tf-animate (one sequence at a time)");
+    if (a.orbit && a.repeat != 1) throw Error("--repeat", "frames", "not with --orbit");
+    if (a.orbit && !a.heatmap.empty()) throw Error("--heatmap", "frames", "not with --orbit");
+    if (a.orbit && (a.segments.active() || a.slice.renderer == "slice"))
+        throw Error("--orbit", "renderer", "the ray marcher only (not --renderer slice or segments)");
+    if (!a.movie.empty()) {
+        if (!sequence) throw Error("--movie", "frames", "needs --orbit N or --tf-animate A B");
+        if (a.accel == "all" || a.accel.find(',') != std::string::npos)
+            throw Error("--movie", "structure", "one structure only (not a list in --accel)");
+        check_output_path(a.movie, ".mp4");
+        if (a.fps < 1 || a.fps > 240) throw Error("--fps", "frames", "expected 1..240");
+        require_ffmpeg();  // before any work
+    }
+    if (!a.save_session.empty()) {
+        if (!a.tf_animate.empty())
+            throw Error("--save-session", "frames", "a single frame or --orbit, not --tf-animate");
+        check_output_path(a.save_session, ".json");
+    }
+    if (a.out.empty() && a.movie.empty())
+        throw Error("render", "--out", "expected an output .png file");
+    if (!a.out.empty()) check_output_path(a.out, ".png");
+}
+
+// The front and back TFs of the frame: a session file's, else --tf / --tf-back resolved.
+TransferFunction front_tf(const RenderArgs& a) {
+    return a.tf_value ? *a.tf_value : resolve_transfer_function(a.tf);
+}
+std::optional<TransferFunction> back_tf(const RenderArgs& a, const FrameSpec& spec) {
+    if (!spec.two_tfs) return std::nullopt;
+    return a.tf_back_value ? *a.tf_back_value : resolve_transfer_function(a.features.tf_back);
+}
+
+// --session FILE: the frame, volume and TFs from the file (session/session_file.h); only the
+// outputs and how to run come from flags.
+Setup from_session(RenderArgs& a) {
+    const SessionFile f = load_session_file(a.session);
+    const std::string max_memory = a.volume.max_memory;  // how to run, not the frame
+    a.volume = VolumeArgs{};
+    a.volume.max_memory = max_memory;
+    a.volume.path = f.volume.path;
+    a.volume.frame = f.volume.frame;
+    a.volume.raw_spec = f.volume.raw;
+    a.volume.range_value = f.volume.range;
+    a.tf_value = f.tf;
+    a.tf = f.tf.name.empty() ? "session" : f.tf.name;
+    a.tf_back_value = f.tf_back;
+    a.accel = structure_name(f.frame.structure);
+    a.azimuth = f.frame.camera.orbit.azimuth_deg;
+    a.elevation = f.frame.camera.orbit.elevation_deg;
+    a.ortho = f.frame.camera.orbit.projection == Projection::Orthographic;
+    a.slice.renderer = f.frame.renderer == Renderer::Slicer ? "slice" : "march";
+    check_outputs(a);
+    Setup s;
+    s.spec = f.frame;
+    return s;
+}
+
+// --save-session: the command line's frame as a session file (written once the frame is).
+std::string session_text(const RenderArgs& a, const Setup& s) {
+    namespace fs = std::filesystem;
+    if (s.spec.renderer == Renderer::Segments)
+        throw Error("--save-session", "frame.renderer",
+                    "a session of the segment renderer is not supported yet (it would need the "
+                    "label map)");
+    SessionFile f;
+    f.volume.path = fs::absolute(a.volume.path).lexically_normal().string();
+    f.volume.frame = a.volume.frame;
+    f.volume.raw = a.volume.raw_spec ? a.volume.raw_spec : raw_spec_of(a.volume);
+    if (a.volume.range_value) f.volume.range = a.volume.range_value;
+    else if (!a.volume.range.empty()) f.volume.range = parse_range(a.volume.range);
+    f.tf = front_tf(a);
+    f.tf_back = back_tf(a, s.spec);
+    f.frame = s.spec;
+    f.frame.count_samples = false;  // the heat map is an output, not the frame
+    return to_json(f, "--save-session");
+}
+
 Setup validate(RenderArgs& a) {
+    if (!a.session.empty()) return from_session(a);
     if (!a.view.empty()) {
         if (a.azimuth_given || a.elevation_given)
             throw Error("--view", "view",
@@ -121,8 +222,7 @@ Setup validate(RenderArgs& a) {
     const bool labels_alone = a.segments.mode == "labels";
     if (a.tf.empty() && a.tf_animate.empty() && !labels_alone)
         throw Error("render", "--tf", "expected a preset name or a .json file");
-    if (a.out.empty()) throw Error("render", "--out", "expected an output .png file");
-    check_output_path(a.out, ".png");
+    check_outputs(a);
     if (!a.heatmap.empty()) check_output_path(a.heatmap, ".png");
     if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
     if (a.repeat < 1 || a.repeat > 100000) throw Error("--repeat", "frames", "expected 1..100000");
@@ -182,9 +282,9 @@ void print_accel(const Structure& st, const AccelStats& stats) {
 
 void render_one(const RenderArgs& a, const Setup& s) {
     const FrameSpec& spec = s.spec;
-    const TransferFunction tf = resolve_transfer_function(a.tf);
-    std::optional<TransferFunction> back;
-    if (spec.two_tfs) back = resolve_transfer_function(a.features.tf_back);
+    Progress summary("render", a.repeat, "frame");
+    const TransferFunction tf = front_tf(a);
+    const std::optional<TransferFunction> back = back_tf(a, spec);
     Session session(load_volume(a.volume), a.threads);
     session.set_transfer_function(tf);
     // Two TFs: the structure skips only where both are transparent (the session gives it
@@ -198,10 +298,14 @@ void render_one(const RenderArgs& a, const Setup& s) {
     // the reported time is the median of the N - 1 frames after it (every frame gives the same
     // bytes: the renderer is deterministic).
     FrameResult r = session.render(spec);
+    summary.step(1);
     const double first_ms = r.stats.seconds * 1e3;
     if (a.repeat > 1) {
         std::vector<RenderStats> warm;
-        for (int f = 1; f < a.repeat; ++f) warm.push_back(session.render(spec).stats);
+        for (int f = 1; f < a.repeat; ++f) {
+            warm.push_back(session.render(spec).stats);
+            summary.step(f + 1);
+        }
         std::sort(warm.begin(), warm.end(),
                   [](const RenderStats& x, const RenderStats& y) { return x.seconds < y.seconds; });
         r.stats = warm[warm.size() / 2];
@@ -228,6 +332,51 @@ void render_one(const RenderArgs& a, const Setup& s) {
                 r.stats.seconds * 1e3, r.stats.samples_per_ray(), r.stats.msamples_per_second(),
                 r.stats.msamples_per_second() / resolve_threads(a.threads), r.stats.cpu_seconds * 1e3);
     std::printf("wrote %s\n", a.out.c_str());
+    std::fflush(stdout);
+    summary.done();
+}
+
+// --orbit N: N frames of one spec, the azimuth stepping a turn from --azimuth at a fixed
+// elevation, through one session (the structure is built once). Each frame goes to its numbered
+// PNG and, with --movie, to ffmpeg; the MP4 appears only when every frame is in and ffmpeg
+// succeeded.
+void render_orbit(const RenderArgs& a, const Setup& s) {
+    FrameSpec spec = s.spec;
+    const TransferFunction tf = front_tf(a);
+    const std::optional<TransferFunction> back = back_tf(a, spec);
+    Session session(load_volume(a.volume), a.threads);
+    session.set_transfer_function(tf);
+    if (back) session.set_back_transfer_function(back);
+    Progress building("building " + structure_name(spec.structure));
+    session.prepare(spec);
+    building.done();
+    if (!a.no_refine) session.refine();
+    std::optional<MovieWriter> movie;
+    if (!a.movie.empty()) movie.emplace(a.movie, spec.width, spec.height, a.fps);
+    Progress progress("render", a.orbit, "frame");
+    double frame_sum = 0, spr_sum = 0;
+    for (int i = 0; i < a.orbit; ++i) {
+        spec.camera.orbit.azimuth_deg = orbit_azimuth(a.azimuth, i, a.orbit);
+        const FrameResult r = session.render(spec);
+        if (!a.out.empty()) write_png(frame_path(a.out, i, a.orbit), r.image);
+        if (movie) movie->add(r.image);
+        frame_sum += r.stats.seconds;
+        spr_sum += r.stats.samples_per_ray();
+        progress.step(i + 1);
+    }
+    if (movie) movie->finish();
+    std::printf("%s: orbit of %d frames from azimuth %g at elevation %g, %dx%d, tf %s, accel %s, "
+                "%d threads\n",
+                a.volume.path.c_str(), a.orbit, a.azimuth, a.elevation, spec.width, spec.height,
+                tf.name.c_str(), a.accel.c_str(), resolve_threads(a.threads));
+    std::printf("frame time %.1f ms (mean), %.1f samples/ray\n", frame_sum / a.orbit * 1e3,
+                spr_sum / a.orbit);
+    if (!a.out.empty())
+        std::printf("wrote %s .. %s\n", frame_path(a.out, 0, a.orbit).c_str(),
+                    frame_path(a.out, a.orbit - 1, a.orbit).c_str());
+    if (movie) std::printf("wrote %s (%d frames at %d fps)\n", a.movie.c_str(), movie->frames(), a.fps);
+    std::fflush(stdout);
+    progress.done();
 }
 
 // The TF animation: frames with the TF interpolated from A to B. For every structure the TF
@@ -239,7 +388,11 @@ void render_animation(const RenderArgs& a, const Setup& s) {
     const TransferFunction tf_a = resolve_transfer_function(a.tf_animate[0]);
     const TransferFunction tf_b = resolve_transfer_function(a.tf_animate[1]);
     Session session(load_volume(a.volume), a.threads);
-    const bool write_frames = kinds.size() == 1;
+    const bool write_frames = kinds.size() == 1 && !a.out.empty();
+    std::optional<MovieWriter> movie;
+    if (!a.movie.empty()) movie.emplace(a.movie, s.spec.width, s.spec.height, a.fps);
+    Progress progress("render", int64_t(kinds.size()) * a.frames, "frame");
+    int64_t frames_done = 0;
     std::printf("%s: TF animation %s -> %s, %d frames at %dx%d, %d threads\n", a.volume.path.c_str(),
                 tf_a.name.c_str(), tf_b.name.c_str(), a.frames, s.spec.width, s.spec.height,
                 resolve_threads(a.threads));
@@ -255,7 +408,6 @@ void render_animation(const RenderArgs& a, const Setup& s) {
         const double build_ms = session.prepare(spec).structure->build_seconds * 1e3;
         building.done();
         double tf_sum = 0, tf_max = 0, frame_sum = 0, spr_sum = 0;
-        Progress progress("animating " + to_string(k));
         for (int f = 0; f < a.frames; ++f) {
             const float w = float(f) / float(a.frames - 1);
             const auto t0 = std::chrono::steady_clock::now();
@@ -264,25 +416,28 @@ void render_animation(const RenderArgs& a, const Setup& s) {
             const double tf_change =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             const FrameResult r = session.render(spec);
-            if (write_frames) write_png(frame_path(a.out, f), r.image);
+            if (write_frames) write_png(frame_path(a.out, f, a.frames), r.image);
+            if (movie) movie->add(r.image);
             tf_sum += tf_change;
             tf_max = std::max(tf_max, tf_change);
             frame_sum += r.stats.seconds;
             spr_sum += r.stats.samples_per_ray();
-            progress.update(double(f + 1) / a.frames);
+            progress.step(++frames_done);
         }
-        progress.done();
         std::printf("%-10s %12.1f %16.3f %16.3f %14.1f %12.1f\n", to_string(k).c_str(), build_ms,
                     tf_sum / a.frames * 1e3, tf_max * 1e3, frame_sum / a.frames * 1e3,
                     spr_sum / a.frames);
     }
+    if (movie) movie->finish();
     if (write_frames)
-        std::printf("wrote %s .. %s\n", frame_path(a.out, 0).c_str(),
-                    frame_path(a.out, a.frames - 1).c_str());
+        std::printf("wrote %s .. %s\n", frame_path(a.out, 0, a.frames).c_str(),
+                    frame_path(a.out, a.frames - 1, a.frames).c_str());
+    if (movie) std::printf("wrote %s (%d frames at %d fps)\n", a.movie.c_str(), movie->frames(), a.fps);
+    std::fflush(stdout);
+    progress.done();
 }
 
-void run(RenderArgs& a) {
-    const Setup s = validate(a);
+void render_frames(RenderArgs& a, const Setup& s) {
     // What `auto` resolved to, for the reports: the segment renderer's fastest exact structure is
     // the label bitfield octree; the slicer slices the whole volume (its structures are the
     // papers' boxes, chosen explicitly); the ray marcher takes default_accel().
@@ -291,19 +446,41 @@ void run(RenderArgs& a) {
                               : s.spec.renderer == Renderer::Slicer   ? "none"
                                                                       : a.accel;
     switch (s.spec.renderer) {
-        case Renderer::Segments:
+        case Renderer::Segments: {
+            Progress summary("render", 1, "frame");
             render_segments(a.segments, SegmentFrame{a.volume, a.tf, accel, a.threads, s.spec,
                                                      a.out, a.heatmap});
+            std::fflush(stdout);
+            summary.done();
             return;
-        case Renderer::Slicer:
-            render_slice({a.volume, a.tf, accel, a.out, a.threads, s.spec});
+        }
+        case Renderer::Slicer: {
+            Progress summary("render", 1, "frame");
+            render_slice({a.volume, a.tf, accel, a.out, a.threads, s.spec, a.tf_value});
+            std::fflush(stdout);
+            summary.done();
             return;
+        }
         case Renderer::RayMarcher:
-            if (a.tf_animate.empty())
+            if (a.orbit)
+                render_orbit(a, s);
+            else if (a.tf_animate.empty())
                 render_one(a, s);
             else
                 render_animation(a, s);
             return;
+    }
+}
+
+void run(RenderArgs& a) {
+    const Setup s = validate(a);
+    // The session file's text before any work (what it cannot hold fails now); written after
+    // the frame, so a failed render leaves none.
+    const std::string session = a.save_session.empty() ? "" : session_text(a, s);
+    render_frames(a, s);
+    if (!session.empty()) {
+        io::write_text_atomic(a.save_session, session);
+        std::printf("wrote %s\n", a.save_session.c_str());
     }
 }
 
@@ -320,6 +497,18 @@ void register_render(CLI::App& app) {
                     "the TF-change time per structure")
         ->expected(2);
     cmd->add_option("--frames", a->frames, "Frames of --tf-animate")->capture_default_str();
+    cmd->add_option("--orbit", a->orbit,
+                    "Render N frames around the volume: azimuth from --azimuth in steps of 360/N "
+                    "degrees, elevation fixed (frames NAME_0000.png, ...)");
+    cmd->add_option("--movie", a->movie,
+                    "With --orbit or --tf-animate: also write the frames as an H.264 MP4 (needs "
+                    "the ffmpeg program; --out then optional)");
+    cmd->add_option("--fps", a->fps, "Frames per second of --movie")->capture_default_str();
+    cmd->add_option("--session", a->session,
+                    "Render the frame a session file describes (volume, TFs, camera, structure, "
+                    "features); flags may add only outputs, --orbit/--movie/--fps and --threads");
+    cmd->add_option("--save-session", a->save_session,
+                    "Also write this frame as a session file (.json) for --session");
     cmd->add_flag("--no-refine", a->no_refine,
                   "Render without the structure's finer per-TF level (the grid's visible-cell "
                   "mask; A/B measurements)");
@@ -340,7 +529,7 @@ void register_render(CLI::App& app) {
                     "Octree level traversal starts at (-1 = root)")
         ->capture_default_str();
     cmd->add_flag("--top-down", a->top_down, "Octree traversal restarts at the initial level");
-    cmd->add_option("--out,-o", a->out, "Output PNG (animation frames: NAME_000.png, ...)");
+    cmd->add_option("--out,-o", a->out, "Output PNG (sequences: NAME_0000.png, ...)");
     cmd->add_option("--heatmap", a->heatmap, "Also write a per-pixel sample-count heat map PNG");
     cmd->add_option("--size", a->size, "Image width and height in pixels")->capture_default_str();
     cmd->add_option("--width", a->width, "Image width (overrides --size)");
@@ -375,6 +564,20 @@ void register_render(CLI::App& app) {
         a->slice.coalesce_given = cmd->count("--coalesce") > 0;
         a->azimuth_given = cmd->count("--azimuth") > 0;
         a->elevation_given = cmd->count("--elevation") > 0;
+        if (!a->session.empty()) {
+            // The file is the frame: a flag that would change it is refused, not ignored.
+            static const char* const kAllowed[] = {"--session", "--out", "--threads", "--orbit",
+                                                   "--movie",   "--fps", "--quiet",   "--save-session",
+                                                   "--max-memory", "--no-refine", "--repeat"};
+            for (const CLI::Option* o : cmd->get_options()) {
+                if (o->count() == 0) continue;
+                bool ok = false;
+                for (const char* n : kAllowed) ok = ok || o->check_lname(n + 2);
+                if (!ok)
+                    throw Error("--session", "flags",
+                                "the session file sets the frame; drop " + o->get_name());
+            }
+        }
         run(*a);
     });
 }

@@ -51,7 +51,7 @@ void check_slice_options(const SliceCliArgs& a, bool animate, bool heatmap) {
 }
 
 void render_slice(const SliceRenderJob& job) {
-    const TransferFunction tf = resolve_transfer_function(job.tf);
+    const TransferFunction tf = job.tf_value ? *job.tf_value : resolve_transfer_function(job.tf);
     Session session(load_volume(job.volume), job.threads);
     session.set_transfer_function(tf);
     Progress progress("building " + job.accel);

@@ -1,10 +1,12 @@
 // `lacuna render --renderer slice`: the object-order slice renderer (docs/slicer.md). Kept out of
 // cmd_render.cpp so the ray-marcher path stays as it was.
 #pragma once
+#include <optional>
 #include <string>
 
 #include "cli_common.h"
 #include "lacuna/frame_spec.h"
+#include "lacuna/transfer_function.h"
 #include "slice/growing_boxes.h"
 
 namespace lacuna::cli {
@@ -29,6 +31,7 @@ struct SliceRenderJob {
     std::string tf, accel, out;  // accel: the --accel name, for the report
     int threads = 0;
     FrameSpec spec;
+    std::optional<TransferFunction> tf_value;  // a session file's TF (instead of resolving `tf`)
 };
 void render_slice(const SliceRenderJob& job);
 

@@ -82,9 +82,9 @@ TEST(Cli, TfAnimationWritesFramesAndReportsTfChangeTime) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("TF change"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("bitfield"), std::string::npos) << r.out;
-    for (const char* f : {"anim_000.png", "anim_001.png", "anim_002.png"})
+    for (const char* f : {"anim_0000.png", "anim_0001.png", "anim_0002.png"})
         EXPECT_TRUE(fs::exists(temp_dir() / f)) << f;
-    EXPECT_FALSE(fs::exists(temp_dir() / "anim_003.png"));
+    EXPECT_FALSE(fs::exists(temp_dir() / "anim_0003.png"));
     CliRun all = run("render " + small_volume().string() +
                      " --tf-animate mr-default mr-gap --frames 2 --accel all --size 16 --out " +
                      (temp_dir() / "all.png").string());
