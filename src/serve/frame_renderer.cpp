@@ -5,6 +5,8 @@
 #include <mutex>
 
 #include "core/parallel.h"
+#include "lacuna/error.h"
+#include "lacuna/mpr.h"
 #include "render/sample_analysis.h"
 
 namespace lacuna::serve {
@@ -54,6 +56,38 @@ FrameRenderer::~FrameRenderer() = default;
 void FrameRenderer::set_labels(Volume labels) {
     check_label_volume(labels, &m_session->volume(), "labels");
     m_session->set_labels(std::move(labels));
+    (void)m_session->label_table();  // built now, so slice() only reads it
+}
+
+FrameRenderer::SliceImage FrameRenderer::slice(const SliceRequest& req, int max_side) const {
+    const Clock::time_point t0 = Clock::now();
+    const bool overlay = req.overlay_opacity > 0;
+    if (overlay && !m_session->has_labels())
+        throw Error("slice", "overlay_opacity", "no label volume loaded (`lacuna serve --labels`)");
+    SliceOptions o;
+    o.interpolation = req.interpolation;
+    o.max_size = req.max_size > 0 ? std::min(req.max_size, max_side) : max_side;
+    o.threads = m_threads;
+    const Volume& v = m_session->volume();
+    const Slice s = sample_slice(v, slice_geometry(v, req.plane, req.point, o), o.interpolation,
+                                 o.threads);
+    SliceImage out;
+    out.geometry = s.geometry;
+    out.image = window_level(s, req.window, req.level);
+    if (overlay) {
+        overlay_labels(out.image, sample_labels(m_session->label_volume(), s.geometry, m_threads),
+                       m_session->label_table(), req.overlay_opacity);
+        out.overlay = true;
+    }
+    out.seconds = seconds_since(t0);
+    return out;
+}
+
+ProbeResult FrameRenderer::probe(const ProbeRequest& req) const {
+    const bool labels = m_session->has_labels();
+    return lacuna::probe(m_session->volume(), req.point, req.interpolation,
+                         labels ? &m_session->label_volume() : nullptr,
+                         labels ? &m_session->label_table() : nullptr);
 }
 
 // What `lacuna render` does with the same settings: the orbit camera (fov 30, perspective), ert

@@ -56,6 +56,20 @@ class FrameRenderer {
     // never waits for it and the frames after it use it.
     void refine();
 
+    // A slice pane's picture (lacuna/mpr.h): the slice at window/level, the label overlay when
+    // asked; its geometry for the header. Thread-safe against render(): it reads only the
+    // volume, the label volume and its table, which are fixed once the server runs (the server
+    // answers slices on its network thread). Throws lacuna::Error("slice", field, ...), e.g.
+    // "overlay_opacity" without a label volume.
+    struct SliceImage {
+        Image image;
+        SliceGeometry geometry;
+        bool overlay = false;
+        double seconds = 0;
+    };
+    SliceImage slice(const SliceRequest& req, int max_side) const;
+    ProbeResult probe(const ProbeRequest& req) const;
+
     // The frame a request describes, at width x height.
     FrameSpec frame_spec(const ViewRequest& req, int width, int height) const;
 

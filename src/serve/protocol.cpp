@@ -111,7 +111,113 @@ uint64_t id_of(const json& j) {
     return v.get<uint64_t>();
 }
 
+// "point": [x, y, z], finite RAS mm within 1e9.
+Vec3d point_of(const json& j, const std::string& where) {
+    const json& p = need(j, "point", where);
+    bool ok = p.is_array() && p.size() == 3;
+    for (size_t i = 0; ok && i < 3; ++i)
+        ok = p[i].is_number() && std::isfinite(p[i].get<double>()) && std::abs(p[i].get<double>()) <= 1e9;
+    if (!ok) reject(where + "point", "expected [x, y, z]: finite numbers (RAS mm), got " + p.dump().substr(0, 80));
+    return {p[0].get<double>(), p[1].get<double>(), p[2].get<double>()};
+}
+
+Interpolation interpolation_of(const json& j, const std::string& where) {
+    const std::string name = text_of(j, "interpolation", where);
+    if (name == "trilinear") return Interpolation::Trilinear;
+    if (name == "nearest") return Interpolation::Nearest;
+    reject(where + "interpolation", "unknown '" + name.substr(0, 40) + "'; expected trilinear or nearest");
+}
+
+json vec_json(Vec3d v) {
+    return json::array({v.x, v.y, v.z});
+}
+
 }  // namespace
+
+MessageKind message_kind(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    const std::string type = text_of(j, "type", "");
+    if (type == "render") return MessageKind::Render;
+    if (type == "slice") return MessageKind::Slice;
+    if (type == "probe") return MessageKind::Probe;
+    reject("type", "unknown message type '" + type.substr(0, 40) + "'; expected render, slice or probe");
+}
+
+std::vector<std::string> message_names() {
+    return {"render", "slice", "probe"};
+}
+
+SliceRequest parse_slice_request(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    if (text_of(j, "type", "") != "slice") reject("type", "expected slice");
+    only_keys(j, {"type", "id", "plane", "point", "window", "level", "interpolation",
+                  "overlay_opacity", "max_size"},
+              "");
+    SliceRequest r;
+    r.id = id_of(j);
+    r.plane = parse_slice_plane(text_of(j, "plane", ""), "message");  // "message: plane: ..."
+    r.point = point_of(j, "");
+    const json& w = need(j, "window", "");
+    if (!w.is_number() || !std::isfinite(w.get<double>()) || w.get<double>() <= 0 ||
+        w.get<double>() > 1e12)
+        reject("window", "expected a positive number (at most 1e12), got " + w.dump().substr(0, 40));
+    r.window = w.get<double>();
+    r.level = number(j, "level", -1e12, 1e12, "");
+    r.interpolation = interpolation_of(j, "");
+    if (j.contains("overlay_opacity")) r.overlay_opacity = float(number(j, "overlay_opacity", 0, 1, ""));
+    if (j.contains("max_size")) r.max_size = integer(j, "max_size", 1, limits.max_side, "");
+    return r;
+}
+
+ProbeRequest parse_probe_request(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    if (text_of(j, "type", "") != "probe") reject("type", "expected probe");
+    only_keys(j, {"type", "id", "point", "interpolation"}, "");
+    ProbeRequest r;
+    r.id = id_of(j);
+    r.point = point_of(j, "");
+    if (j.contains("interpolation")) r.interpolation = interpolation_of(j, "");
+    return r;
+}
+
+std::string slice_header(const SliceInfo& s) {
+    const SliceGeometry& g = s.geometry;
+    json j{{"type", "slice"},
+           {"id", s.id},
+           {"plane", to_string(g.plane)},
+           {"width", g.width},
+           {"height", g.height},
+           {"origin", vec_json(g.origin)},
+           {"u", vec_json(g.u)},
+           {"v", vec_json(g.v)},
+           {"pixel_mm", g.pixel_mm},
+           {"interpolation", to_string(s.interpolation)},
+           {"overlay", s.overlay},
+           {"slice_ms", s.slice_ms},
+           {"encode_ms", s.encode_ms}};
+    return j.dump();
+}
+
+std::string slice_message(const SliceInfo& s, std::string_view jpeg) {
+    const std::string header = slice_header(s);
+    std::string out(4, '\0');
+    const uint32_t n = uint32_t(header.size());
+    for (int b = 0; b < 4; ++b) out[size_t(b)] = char((n >> (8 * b)) & 0xff);
+    out += header;
+    out.append(jpeg.data(), jpeg.size());
+    return out;
+}
+
+std::string probe_message(uint64_t id, const ProbeResult& p) {
+    json j{{"type", "probe"}, {"id", id}, {"point", vec_json(p.world)}, {"inside", p.inside},
+           {"index", vec_json(p.index)}};
+    j["voxel"] = p.inside ? json::array({p.voxel.x, p.voxel.y, p.voxel.z}) : json(nullptr);
+    j["value"] = p.inside ? json(p.value) : json(nullptr);
+    j["voxel_value"] = p.inside ? json(p.voxel_value) : json(nullptr);
+    j["label"] = p.label ? json(*p.label) : json(nullptr);
+    j["label_name"] = p.label_name;
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
 
 std::string to_string(RendererKind k) {
     switch (k) {
@@ -300,6 +406,9 @@ std::string hello_message(const HelloInfo& h) {
     }
     j["capabilities"] = caps;
     j["labels"] = h.labels;
+    j["messages"] = message_names();
+    j["slice_views"] = {{"planes", {"axial", "coronal", "sagittal"}},
+                        {"interpolations", {"trilinear", "nearest"}}};
     j["limits"] = {{"max_message_bytes", h.limits.max_message_bytes},
                    {"max_side", h.limits.max_side},
                    {"max_tf_points", h.limits.max_tf_points}};

@@ -13,11 +13,18 @@
 //                                          patient RAS mm, keeping dot(n, p) >= d)
 //    "tf":{...the transfer-function JSON of docs/transfer-functions.md...}}
 //   Every request carries the whole view state, so the server can drop all but the latest.
+//   {"type":"slice", "id":N, "plane":"axial|coronal|sagittal", "point":[x,y,z] (RAS mm),
+//    "window":W (> 0), "level":L, "interpolation":"trilinear|nearest",
+//    ["overlay_opacity":[0,1] (the label overlay; needs `serve --labels`), "max_size":N]}
+//   {"type":"probe", "id":N, "point":[x,y,z], ["interpolation":...]}
+//   Slices and probes are answered in order, never dropped (lacuna/mpr.h: one slice <= 30 ms).
 //   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
 //   with an "error" message naming the field; the connection stays open.
 // Server -> page:
 //   text   {"type":"hello", ...}    once, on connect: volume, histogram, presets, accels,
-//                                    renderers, capabilities, limits
+//                                    renderers, capabilities, limits, "messages" (the
+//                                    types the server answers: render, slice, probe) and
+//                                    "slice_views" {"planes", "interpolations"}
 //          "capabilities": {"march": {"accels": [...], "features": [...]}, "slice": {...},
 //                           "segments": {"renderer": "march", "accels": [...], "features": [...]}}
 //          is lacuna::capabilities() (lacuna/frame_spec.h) in the page's words: which of the
@@ -26,6 +33,11 @@
 //          "clip_planes", ...). The page decides nothing else about what combines with what.
 //   text   {"type":"error", "id":N|null, "message":"..."}
 //   binary [u32 little-endian n][n bytes of JSON header {"type":"frame", ...}][JPEG bytes]
+//   binary [u32 LE n][{"type":"slice", "id", "plane", "width", "height", "origin":[mm],
+//           "u":[mm], "v":[mm], "pixel_mm", ...}][JPEG]: pixel (c, r) (column c from the left,
+//           row r from the top) is at origin + c u + r v, RAS mm, so a click maps to the world
+//   text   {"type":"probe", "id", "point", "inside", "index":[continuous], "voxel":[i,j,k]|null,
+//           "value"|null, "voxel_value"|null, "label"|null, "label_name"}
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -35,6 +47,7 @@
 
 #include "lacuna/accel.h"
 #include "lacuna/frame_spec.h"
+#include "lacuna/mpr.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
@@ -83,6 +96,32 @@ struct ViewRequest {
     TransferFunction tf;
 };
 
+// A slice pane's request (docs/viewer.md, lacuna/mpr.h).
+struct SliceRequest {
+    uint64_t id = 0;
+    SlicePlane plane = SlicePlane::Axial;
+    Vec3d point;  // RAS mm
+    double window = 1, level = 0;
+    Interpolation interpolation = Interpolation::Trilinear;
+    float overlay_opacity = 0;  // 0: no label overlay
+    int max_size = 0;           // 0: the slice's own size (bounded by Limits::max_side)
+};
+struct ProbeRequest {
+    uint64_t id = 0;
+    Vec3d point;
+    Interpolation interpolation = Interpolation::Trilinear;
+};
+
+// The kinds of message the page sends, by "type".
+enum class MessageKind { Render, Slice, Probe };
+// The message's "type" (throws lacuna::Error("message", "type"/"json"/..., ...) like
+// parse_request for anything but render, slice or probe).
+MessageKind message_kind(std::string_view text, const Limits& limits = {});
+SliceRequest parse_slice_request(std::string_view text, const Limits& limits = {});
+ProbeRequest parse_probe_request(std::string_view text, const Limits& limits = {});
+// The message kinds the hello lists under "messages".
+std::vector<std::string> message_names();
+
 // The FrameSpec renderer and structure a request's "renderer", "segments" and "accel" name: the
 // segments toggle is the segment renderer (drawn on the ray marcher's lattice), whose "bitfield"
 // is the label bitfield octree; every other accel is the structure of that name, its parameters
@@ -127,6 +166,18 @@ struct FrameInfo {
 std::string frame_header(const FrameInfo& f);
 // [u32 LE header length][header][jpeg]
 std::string frame_message(const FrameInfo& f, std::string_view jpeg);
+
+// The slice's binary message: [u32 LE header length][header][jpeg].
+struct SliceInfo {
+    uint64_t id = 0;
+    SliceGeometry geometry;
+    Interpolation interpolation = Interpolation::Trilinear;
+    bool overlay = false;
+    double slice_ms = 0, encode_ms = 0;
+};
+std::string slice_header(const SliceInfo& s);
+std::string slice_message(const SliceInfo& s, std::string_view jpeg);
+std::string probe_message(uint64_t id, const ProbeResult& p);
 
 std::string error_message(const std::string& message, std::optional<uint64_t> id);
 

@@ -202,6 +202,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             send_text(error_message("message: binary: expected a JSON text message", std::nullopt));
         } else {
             try {
+                const MessageKind kind = message_kind(text, m_server->options.limits);
+                if (kind != MessageKind::Render) {
+                    answer_slice_or_probe(kind, text);
+                    read();
+                    return;
+                }
                 ViewRequest req = parse_request(text, m_server->options.limits);
                 {
                     std::lock_guard<std::mutex> lock(m_server->slot_mutex);
@@ -216,6 +222,37 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             }
         }
         read();
+    }
+
+    // Slices and probes are answered here, on the network thread, in order: a slice takes
+    // milliseconds (lacuna/mpr.h) and reads only what the render thread never changes
+    // (FrameRenderer::slice). A failure is an error message naming the field; the socket stays.
+    void answer_slice_or_probe(MessageKind kind, const std::string& text) {
+        const Limits& limits = m_server->options.limits;
+        if (kind == MessageKind::Probe) {
+            const ProbeRequest req = parse_probe_request(text, limits);
+            send_text(probe_message(req.id, m_server->renderer.probe(req)));
+            return;
+        }
+        const SliceRequest req = parse_slice_request(text, limits);
+        try {
+            const FrameRenderer::SliceImage s = m_server->renderer.slice(req, limits.max_side);
+            SliceInfo info;
+            info.id = req.id;
+            info.geometry = s.geometry;
+            info.interpolation = req.interpolation;
+            info.overlay = s.overlay;
+            info.slice_ms = s.seconds * 1e3;
+            const Clock::time_point e0 = Clock::now();
+            const std::string jpeg = encode_jpeg(s.image, m_server->options.jpeg_quality);
+            info.encode_ms = std::chrono::duration<double, std::milli>(Clock::now() - e0).count();
+            m_binaries.push_back(slice_message(info, jpeg));
+            pump();
+        } catch (const Error& e) {
+            send_text(error_message(e.what(), req.id));
+        } catch (const std::exception& e) {  // out of memory: report, keep serving
+            send_text(error_message(std::string("slice: ") + e.what(), req.id));
+        }
     }
 
     void finish() {
@@ -236,6 +273,10 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             m_out = std::move(m_texts.front());
             m_texts.pop_front();
             m_ws.text(true);
+        } else if (!m_binaries.empty()) {
+            m_out = std::move(m_binaries.front());
+            m_binaries.pop_front();
+            m_ws.binary(true);
         } else if (m_frame) {
             m_out = std::move(*m_frame);
             m_frame.reset();
@@ -259,6 +300,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     beast::flat_buffer m_buffer;
     std::deque<std::string> m_texts;
     std::optional<std::string> m_frame;
+    std::deque<std::string> m_binaries;  // slices: answered in order, never dropped
     std::string m_out;  // the message being written (alive until on_write)
     bool m_writing = false;
     Clock::time_point m_last_active = Clock::now();  // connect, then the last message read
