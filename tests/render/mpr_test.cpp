@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "common/rng.h"
+#include "lacuna/error.h"
 #include "lacuna/mpr.h"
 #include "lacuna/orientation.h"
 #include "render/orientation_test_util.h"
@@ -296,7 +297,9 @@ TEST(Mpr, LabelOverlayUsesNearestLabelsAndTheirColours) {
                 // away from a rounding tie, nearest is unambiguous
                 bool tie = false;
                 for (int a = 0; a < 3; ++a) tie |= std::abs(li[a] - std::floor(li[a]) - 0.5) < 1e-4;
-                if (!tie) ASSERT_EQ(ls[p], want) << c << "," << r;
+                if (!tie) {
+                    ASSERT_EQ(ls[p], want) << c << "," << r;
+                }
             } else if (clearly_outside(labels, li, 1e-3)) {
                 ASSERT_EQ(ls[p], -1);
             }
