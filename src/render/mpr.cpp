@@ -219,7 +219,7 @@ Image window_level(const Slice& s, double window, double level, const std::strin
 
 void overlay_labels(Image& img, const std::vector<int32_t>& labels, const LabelTable& table,
                     float opacity) {
-    const float a = std::clamp(std::isnan(opacity) ? 0.f : opacity, 0.f, 1.f);
+    const double a = std::clamp(std::isnan(opacity) ? 0.f : opacity, 0.f, 1.f);
     const size_t n = std::min(labels.size(), img.rgba.size() / 4);
     for (size_t i = 0; i < n; ++i) {
         const int32_t l = labels[i];
@@ -228,8 +228,8 @@ void overlay_labels(Image& img, const std::vector<int32_t>& labels, const LabelT
         const float col[3] = {st.r, st.g, st.b};
         uint8_t* px = &img.rgba[i * 4];
         for (int ch = 0; ch < 3; ++ch) {
-            const float grey = float(px[ch]);
-            const float target = std::clamp(col[ch], 0.f, 1.f) * 255.f;
+            const double grey = double(px[ch]);
+            const double target = double(std::clamp(col[ch], 0.f, 1.f)) * 255.0;
             px[ch] = uint8_t(std::lround(grey + a * (target - grey)));
         }
     }

@@ -124,10 +124,13 @@ TEST(Mpr, TrilinearMatchesDoublePrecisionOnAnObliqueVolume) {
             SliceOptions o;
             o.pixel_mm = 0.37;  // off the lattice on purpose
             const Slice s = sample_slice(v, pl, pt, o);
-            expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 2e-3 * 2000,
-                         to_string(pl));
-            // Tighter: float weights on values up to 1500 stay within ~1e-3 relative.
-            expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.05, to_string(pl));
+            // Tolerance, from the kernel's float arithmetic (the index is exact in double, then
+            // rounded to float). Indices below 32 round by <= 2^-20 ~ 9.5e-7 voxels per axis;
+            // neighbouring voxels differ by <= 2000, so the cell's trilinear moves by <= 3 axes
+            // x 2000 x 9.5e-7 = 5.7e-3. The 7 lerps on values <= 1500 round by <= 2 x 2^-14 ~
+            // 1.2e-4 each: < 1e-3 in all. Bound 6.7e-3; 0.01 leaves a margin, a wrong corner or
+            // weight is off by tens.
+            expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.01, to_string(pl));
         }
 }
 
@@ -144,8 +147,9 @@ TEST(Mpr, LinearRampComesOutLinearStraightAndOblique) {
             o.pixel_mm = 0.61;
             const Vec3d pt = Vec3d(world_bounds(v).center()) + Vec3d{0.3, -0.7, 0.45};
             const Slice s = sample_slice(v, pl, pt, o);
-            expect_slice(v, s, [](Vec3d p) { return 2 * p.x - 3 * p.y + 5 * p.z + 7; }, 2e-4 * 200,
-                         std::string(oblique ? "oblique " : "straight ") + to_string(pl));
+            // Trilinear reproduces a linear function exactly, up to float: the index rounds by
+            // <= 9.5e-7 voxels per axis (indices < 32), moving the ramp by <= (2 + 3 + 5) x
+            // 9.5e-7 ~ 1e-5, and 7 lerps on values <= 256 round by <= 7 x 2^-16 ~ 1.1e-4.
             expect_slice(v, s, [](Vec3d p) { return 2 * p.x - 3 * p.y + 5 * p.z + 7; }, 1e-3,
                          std::string(oblique ? "oblique " : "straight ") + to_string(pl));
         }
@@ -219,7 +223,15 @@ TEST(Mpr, PhantomInThreeVoxelOrdersGivesTheSameSlices) {
                             continue;
                         }
                         ++shown;
-                        ASSERT_NEAR(x, y, in == Interpolation::Nearest ? 0.0 : 1e-3)
+                        // Trilinear: the two copies reach the same world point through different
+                        // affines, so each index is the exact one rounded to float: <= 2^-19 ~
+                        // 1.9e-6 voxels per axis (indices < 64). The phantom's neighbouring
+                        // voxels differ by <= 133 (220 over 2.5 mm, spacing <= 1.5 mm, rounded),
+                        // so each copy's sample moves by <= 3 x 133 x 1.9e-6 = 7.6e-4, plus
+                        // <= 7 x 2 x 2^-16 ~ 2e-4 of lerp rounding on values <= 255: the two
+                        // differ by <= 2 x 9.6e-4 ~ 1.9e-3 (so 1e-3 was too tight). 5e-3; a
+                        // wrong voxel order is off by whole grey steps. Nearest: the same voxel.
+                        ASSERT_NEAR(x, y, in == Interpolation::Nearest ? 0.0 : 5e-3)
                             << to_string(pl) << " " << to_string(in) << " " << orientation_code(*other)
                             << " pixel " << p;
                     }
@@ -243,7 +255,8 @@ TEST(Mpr, OutsideTheVolumeIsNaNAndShownBlack) {
     for (float x : far.values) ASSERT_TRUE(std::isnan(x));
     // The oblique box's corners on a central plane are outside.
     const Slice s = sample_slice(v, SlicePlane::Coronal, c);
-    expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.05, "coronal");
+    // 0.01: the bound of TrilinearMatchesDoublePrecisionOnAnObliqueVolume (same values).
+    expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.01, "coronal");
     const Image img = window_level(s, 400, 500);
     size_t nan = 0;
     for (size_t p = 0; p < s.values.size(); ++p)
@@ -310,7 +323,7 @@ TEST(Mpr, LabelOverlayUsesNearestLabelsAndTheirColours) {
                 for (int ch = 0; ch < 3; ++ch) {
                     const double g = grey.rgba[p * 4 + size_t(ch)];
                     ASSERT_EQ(int(out.rgba[p * 4 + size_t(ch)]),
-                              int(std::lround(g + 0.4 * (col[ch] * 255.0 - g))));
+                              int(std::lround(g + double(0.4f) * (col[ch] * 255.0 - g))));
                 }
             } else {
                 for (int ch = 0; ch < 4; ++ch)
@@ -346,7 +359,8 @@ TEST(Mpr, ProbeMatchesBruteForce) {
         if (clearly_inside(v, p, 1e-3)) {
             ++in;
             ASSERT_TRUE(pr.inside);
-            ASSERT_NEAR(pr.value, trilinear_d(v, p), 0.05);
+            // 0.01: the bound of TrilinearMatchesDoublePrecisionOnAnObliqueVolume (same values).
+            ASSERT_NEAR(pr.value, trilinear_d(v, p), 0.01);
             const Vec3i nv{int(std::lround(p.x)), int(std::lround(p.y)), int(std::lround(p.z))};
             ASSERT_EQ(pr.voxel, nv);
             ASSERT_EQ(pr.voxel_value, v.value(nv.x, nv.y, nv.z));
