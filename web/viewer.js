@@ -7,6 +7,13 @@
 // latest request per tab). While the camera moves or a TF point is dragged the page asks for
 // previews (the server renders them at reduced resolution); 150 ms after the last input it asks
 // for the full-resolution frame.
+//
+// Slice panes (axial, coronal, sagittal; docs/viewer.md "Slice views"): each asks the server for
+// its plane through the crosshair point with a `slice` message and draws the JPEG it gets back,
+// letterboxed, with the crosshair on top. The reply's header maps pixels to the world (pixel
+// (c, r) is at origin + c u + r v, RAS mm), so a click is a world point: it becomes the crosshair,
+// the other planes are fetched through it, and a `probe` message reads the value there. Each pane
+// has at most one slice in flight (newest state when it arrives), as the 3D view does.
 'use strict';
 
 (() => {
@@ -32,6 +39,13 @@
     // TF in the normalized domain: x in [0,1] across the volume's visualization range (or
     // tf.range when set). color: [x, r, g, b]; opacity: [x, a].
     tf: null,
+    // Slice panes: the crosshair (world RAS mm) and the grey mapping of every pane.
+    point: [0, 0, 0],
+    window: 1,
+    level: 0.5,
+    wlPreset: 'vis',
+    interpolation: 'trilinear',
+    overlayOpacity: 0.4,
   };
   let hello = null;
   let ws = null;
@@ -54,20 +68,27 @@
     ws.binaryType = 'arraybuffer';
     ws.onmessage = (ev) => {
       if (typeof ev.data === 'string') onText(JSON.parse(ev.data));
-      else onFrame(ev.data);
+      else onBinary(ev.data);
     };
     ws.onclose = () => {
       setStatus('disconnected: is `lacuna serve` still running?');
       inFlight = null;
+      probeInFlight = null;
+      for (const pane of Object.values(panes)) pane.inFlight = null;
     };
   }
 
   function onText(msg) {
     if (msg.type === 'hello') return onHello(msg);
+    if (msg.type === 'probe') return onProbe(msg);
     if (msg.type === 'error') {
       // The server rejected a request: show it (not a console error: the page stays usable).
       setStatus('server: ' + msg.message);
       if (msg.id !== null && msg.id === inFlight) { inFlight = null; flush(); }
+      for (const pane of Object.values(panes)) {
+        if (msg.id !== null && msg.id === pane.inFlight) { pane.inFlight = null; flushSlice(pane); }
+      }
+      if (msg.id !== null && msg.id === probeInFlight) { probeInFlight = null; flushProbe(); }
     }
   }
 
@@ -90,13 +111,20 @@
     presets.value = msg.presets[msg.tf.name] ? msg.tf.name : '';
     setStatus('');
     request(false);
+    startSlices(msg);
   }
 
-  function onFrame(buf) {
+  // Binary messages: a frame of the 3D view or a slice of a pane, by the header's type.
+  function onBinary(buf) {
     const bytes = new Uint8Array(buf);
     const n = bytes[0] | (bytes[1] << 8) | (bytes[2] << 16) | (bytes[3] << 24);
     const header = JSON.parse(new TextDecoder().decode(bytes.subarray(4, 4 + n)));
-    const url = URL.createObjectURL(new Blob([bytes.subarray(4 + n)], { type: 'image/jpeg' }));
+    if (header.type === 'slice') onSlice(header, bytes.subarray(4 + n));
+    else onFrame(header, bytes.subarray(4 + n));
+  }
+
+  function onFrame(header, jpeg) {
+    const url = URL.createObjectURL(new Blob([jpeg], { type: 'image/jpeg' }));
     // A frame still decoding when a newer one arrives is superseded: free its blob.
     const superseded = pendingUrl;
     pendingUrl = url;
@@ -582,10 +610,261 @@
     request(false);
   });
 
+  // ---- slice panes (axial, coronal, sagittal) ------------------------------------------------
+  const kPlanes = ['axial', 'coronal', 'sagittal'];
+  // Each plane's normal (lacuna/mpr.h): a pane's picture depends on the crosshair only through
+  // the point's coordinate along it, so moving the point within a plane leaves that pane as it is.
+  const kNormals = { axial: [0, 0, 1], coronal: [0, 1, 0], sagittal: [1, 0, 0] };
+  // 3D Slicer's Volumes module presets, [window, level] in the volume's units (HU for CT);
+  // 'vis' and 'full' come from the volume (its visualization and data ranges).
+  const kWindowLevel = { 'ct-brain': [100, 50], 'ct-abdomen': [350, 40], 'ct-bone': [1000, 400],
+                         'ct-lung': [1400, -500] };
+  const kCrosshair = '#ffcc00';
+  const panes = {};
+  for (const plane of kPlanes) {
+    const el = $('pane-' + plane);
+    panes[plane] = { plane, el, canvas: el.querySelector('canvas'), inFlight: null, dirty: false,
+                     sentKey: null, sentPoints: new Map(), header: null, point: null, bitmap: null,
+                     fit: null, count: 0, arrived: 0, shown: 0, drag: null };
+  }
+  let probeInFlight = null, probeDirty = false, lastProbe = null;
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const slicesServed = () => hello && (hello.messages || []).includes('slice');
+  const hasLabels = () => hello && hello.labels > 0;
+  const fmt = (x) => (Number.isInteger(x) ? String(x) : String(+x.toPrecision(5)));
+
+  function startSlices(msg) {
+    for (const pane of Object.values(panes)) pane.el.hidden = !slicesServed();
+    if (!slicesServed()) return;
+    const b = msg.volume.world_bounds;
+    state.point = b ? [0, 1, 2].map((a) => (b.lo[a] + b.hi[a]) / 2) : [0, 0, 0];
+    fillSelect($('slice-interp'), msg.slice_views.interpolations, state.interpolation);
+    state.interpolation = $('slice-interp').value;
+    $('overlay-row').hidden = !hasLabels();
+    applyWindowLevel(state.wlPreset);
+    requestSlices();
+    requestProbe();
+  }
+
+  // What a pane's picture depends on; a pane is fetched again only when this changes.
+  function sliceKey(pane) {
+    return JSON.stringify([dot(state.point, kNormals[pane.plane]), state.window, state.level,
+                           state.interpolation, hasLabels() ? state.overlayOpacity : 0]);
+  }
+  function requestSlices() {
+    for (const pane of Object.values(panes)) {
+      if (sliceKey(pane) !== pane.sentKey) pane.dirty = true;
+      flushSlice(pane);
+    }
+  }
+  function flushSlice(pane) {
+    if (!pane.dirty || pane.inFlight !== null || !ws || ws.readyState !== WebSocket.OPEN ||
+        !slicesServed()) return;
+    const id = nextId++;
+    const msg = { type: 'slice', id, plane: pane.plane, point: state.point, window: state.window,
+                  level: state.level, interpolation: state.interpolation };
+    if (hasLabels() && state.overlayOpacity > 0) msg.overlay_opacity = state.overlayOpacity;
+    ws.send(JSON.stringify(msg));
+    pane.inFlight = id;
+    pane.sentKey = sliceKey(pane);
+    pane.sentPoints.set(id, state.point.slice());
+    pane.dirty = false;
+  }
+
+  // A slice arrived: decode it off the main path, show it unless a newer one is shown already.
+  function onSlice(header, jpeg) {
+    const pane = panes[header.plane];
+    if (!pane) return;
+    if (header.id === pane.inFlight) pane.inFlight = null;
+    const point = pane.sentPoints.get(header.id);
+    pane.sentPoints.delete(header.id);
+    const seq = ++pane.arrived;
+    createImageBitmap(new Blob([jpeg], { type: 'image/jpeg' })).then((bitmap) => {
+      if (seq < pane.shown) { bitmap.close(); return; }
+      if (pane.bitmap) pane.bitmap.close();
+      pane.shown = seq;
+      pane.bitmap = bitmap;
+      pane.header = header;
+      pane.point = point;
+      pane.count += 1;
+      drawPane(pane);
+    }, (e) => setStatus(`${header.plane} slice: ${e}`));
+    flushSlice(pane);
+  }
+
+  // The slice letterboxed in its pane (its pixels are square: pixel_mm on both axes); pixel
+  // (c, r)'s centre is at canvas (ox + (c + 0.5) s, oy + (r + 0.5) s).
+  function drawPane(pane) {
+    const c = pane.canvas, dpr = Math.min(window.devicePixelRatio || 1, 2);
+    const W = Math.max(1, Math.round(c.clientWidth * dpr)), H = Math.max(1, Math.round(c.clientHeight * dpr));
+    if (c.width !== W || c.height !== H) { c.width = W; c.height = H; }
+    const g = c.getContext('2d');
+    g.fillStyle = '#000';
+    g.fillRect(0, 0, W, H);
+    const h = pane.header;
+    if (!pane.bitmap || !h) return;
+    const s = Math.min(W / h.width, H / h.height);
+    const ox = Math.round((W - s * h.width) / 2), oy = Math.round((H - s * h.height) / 2);
+    pane.fit = { s, ox, oy };
+    g.imageSmoothingEnabled = h.interpolation !== 'nearest';
+    g.drawImage(pane.bitmap, ox, oy, s * h.width, s * h.height);
+    // The crosshair: a 1-pixel line on pixel centres (so its colour is exact).
+    const [x, y] = worldToCanvas(pane, state.point).map((t) => Math.floor(t) + 0.5);
+    g.strokeStyle = kCrosshair;
+    g.lineWidth = 1;
+    g.beginPath();
+    g.moveTo(x, oy);
+    g.lineTo(x, oy + s * h.height);
+    g.moveTo(ox, y);
+    g.lineTo(ox + s * h.width, y);
+    g.stroke();
+  }
+  const drawPanes = () => Object.values(panes).forEach(drawPane);
+
+  // World (RAS mm) <-> canvas pixels through the slice header's map origin + c u + r v.
+  function worldToCanvas(pane, p) {
+    const h = pane.header, f = pane.fit, d = [0, 1, 2].map((a) => p[a] - h.origin[a]);
+    const col = dot(d, h.u) / dot(h.u, h.u), row = dot(d, h.v) / dot(h.v, h.v);
+    return [f.ox + (col + 0.5) * f.s, f.oy + (row + 0.5) * f.s];
+  }
+  // Clamped to the slice's pixels (the volume's box projected on the plane), and kept on the
+  // pane's own plane (the crosshair's coordinate along the normal does not move).
+  function canvasToWorld(pane, x, y) {
+    const h = pane.header, f = pane.fit;
+    const col = clamp((x - f.ox) / f.s - 0.5, 0, h.width - 1), row = clamp((y - f.oy) / f.s - 0.5, 0, h.height - 1);
+    const w = [0, 1, 2].map((a) => h.origin[a] + col * h.u[a] + row * h.v[a]);
+    const n = kNormals[pane.plane], a = n.indexOf(1);
+    w[a] = state.point[a];
+    return w;
+  }
+  function clientToCanvas(pane, e) {
+    const r = pane.canvas.getBoundingClientRect();
+    return [(e.clientX - r.left) * pane.canvas.width / r.width, (e.clientY - r.top) * pane.canvas.height / r.height];
+  }
+
+  function moveCrosshair(pane, e) {
+    state.point = canvasToWorld(pane, ...clientToCanvas(pane, e)).map((t) => Math.round(t * 1e4) / 1e4);
+    drawPanes();
+    requestSlices();
+    requestProbe();
+  }
+
+  // Window/level: the preset menu, or right/shift-drag in a slice (horizontal = window, vertical =
+  // level, as in 3D Slicer; right widens the window, down raises the level), 1/400 of the data
+  // range per pixel.
+  function applyWindowLevel(name) {
+    const v = hello.volume;
+    let wl = kWindowLevel[name];
+    if (name === 'vis' || name === 'full') {
+      const [lo, hi] = name === 'vis' ? v.vis_range : v.data_range;
+      wl = [hi > lo ? hi - lo : 1, (lo + hi) / 2];
+    }
+    if (!wl) return;
+    [state.window, state.level] = wl;
+    state.wlPreset = name;
+    $('wl-preset').value = name;
+    showWindowLevel();
+  }
+  function showWindowLevel() {
+    $('wl-text').textContent = `window ${fmt(state.window)} · level ${fmt(state.level)}`;
+  }
+  function dataRange() {
+    const [lo, hi] = hello.volume.data_range;
+    return hi > lo ? hi - lo : 1;
+  }
+
+  for (const pane of Object.values(panes)) {
+    const el = pane.el;
+    el.addEventListener('contextmenu', (e) => e.preventDefault());
+    el.addEventListener('pointerdown', (e) => {
+      if (!pane.header || !pane.fit) return;
+      el.setPointerCapture(e.pointerId);
+      const wl = e.button === 2 || e.shiftKey;
+      pane.drag = { wl, x: e.clientX, y: e.clientY, window: state.window, level: state.level };
+      if (!wl) moveCrosshair(pane, e);
+    });
+    el.addEventListener('pointermove', (e) => {
+      const d = pane.drag;
+      if (!d) return;
+      if (!d.wl) return moveCrosshair(pane, e);
+      const k = dataRange() / 400;
+      state.window = clamp(d.window + (e.clientX - d.x) * k, dataRange() * 1e-4, 1e12);
+      state.level = clamp(d.level + (e.clientY - d.y) * k, -1e12, 1e12);
+      state.wlPreset = 'custom';
+      $('wl-preset').value = 'custom';
+      showWindowLevel();
+      requestSlices();
+    });
+    const end = (e) => { if (pane.drag) { pane.drag = null; el.releasePointerCapture(e.pointerId); } };
+    el.addEventListener('pointerup', end);
+    el.addEventListener('pointercancel', end);
+    new ResizeObserver(() => drawPane(pane)).observe(el);
+  }
+  $('wl-preset').addEventListener('change', (e) => {
+    if (e.target.value === 'custom') return;
+    applyWindowLevel(e.target.value);
+    requestSlices();
+  });
+  $('slice-interp').addEventListener('change', (e) => {
+    state.interpolation = e.target.value;
+    requestSlices();
+    requestProbe();
+  });
+  $('overlay-opacity').addEventListener('input', (e) => {
+    state.overlayOpacity = Number(e.target.value);
+    $('overlay-value').textContent = e.target.value;
+    requestSlices();
+  });
+
+  // ---- probe: the value under the crosshair ---------------------------------------------------
+  function requestProbe() {
+    probeDirty = true;
+    flushProbe();
+  }
+  function flushProbe() {
+    if (!probeDirty || probeInFlight !== null || !ws || ws.readyState !== WebSocket.OPEN ||
+        !slicesServed()) return;
+    const id = nextId++;
+    ws.send(JSON.stringify({ type: 'probe', id, point: state.point, interpolation: state.interpolation }));
+    probeInFlight = id;
+    probeDirty = false;
+  }
+  function onProbe(msg) {
+    if (msg.id === probeInFlight) probeInFlight = null;
+    lastProbe = msg;
+    const lines = [`RAS ${msg.point.map((x) => x.toFixed(1)).join(', ')} mm`];
+    if (msg.inside) {
+      lines.push(`voxel [${msg.voxel.join(', ')}] = ${fmt(msg.voxel_value)}`);
+      lines.push(`value ${fmt(msg.value)} (${state.interpolation})`);
+    } else {
+      lines.push('outside the volume');
+    }
+    if (hasLabels()) {
+      lines.push(msg.label === null ? 'label –' : `label ${msg.label}${msg.label_name ? ' ' + msg.label_name : ''}`);
+    }
+    $('probe').textContent = lines.join('\n');
+    flushProbe();
+  }
+
   function clamp(v, lo, hi) { return Math.min(hi, Math.max(lo, v)); }
   function round4(v) { return Math.round(v * 10000) / 10000; }
 
   // A small handle for scripts and tests (tests/e2e/viewer.e2e.mjs).
-  window.lacunaViewer = { state, opacityPointClient, frames: () => frames, frameLog, hello: () => hello };
+  // Slice panes: slices() gives each pane's shown slice (its header, the crosshair point it was
+  // fetched through, how many were shown, its place in the canvas, and whether the newest state
+  // is shown: nothing in flight, dirty or decoding); sliceClient(plane, c, r) is the page position of pixel
+  // (c, r)'s centre and crosshairCanvas(plane) the crosshair in canvas pixels; probe() the last
+  // probe answer.
+  const slices = () => Object.fromEntries(kPlanes.map((p) => [p, {
+    header: panes[p].header, point: panes[p].point, count: panes[p].count, fit: panes[p].fit,
+    settled: panes[p].inFlight === null && !panes[p].dirty && panes[p].shown === panes[p].arrived }]));
+  function sliceClient(plane, c, r) {
+    const pane = panes[plane], f = pane.fit, rect = pane.canvas.getBoundingClientRect();
+    const k = rect.width / pane.canvas.width;
+    return { x: rect.left + (f.ox + (c + 0.5) * f.s) * k, y: rect.top + (f.oy + (r + 0.5) * f.s) * k };
+  }
+  const crosshairCanvas = (plane) => worldToCanvas(panes[plane], state.point).map(Math.floor);
+  window.lacunaViewer = { state, opacityPointClient, frames: () => frames, frameLog, hello: () => hello,
+                          slices, sliceClient, crosshairCanvas, probe: () => lastProbe };
   connect();
 })();

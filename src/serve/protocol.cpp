@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lacuna/error.h"
+#include "lacuna/orientation.h"
 #include "lacuna/segments.h"
 #include "lacuna/views.h"
 
@@ -384,6 +385,11 @@ std::string hello_message(const HelloInfo& h) {
                    {"spacing", {v.spacing.x, v.spacing.y, v.spacing.z}},
                    {"data_range", {v.data_range().min, v.data_range().max}},
                    {"vis_range", {v.vis_range().min, v.vis_range().max}}};
+    // Where the volume is in the world (patient RAS mm): the slice panes start their crosshair at
+    // the centre of this box (lacuna/orientation.h world_bounds, the sampled box [0, dims-1]).
+    const Box3f b = world_bounds(v);
+    j["volume"]["world_bounds"] = {{"lo", {b.lo.x, b.lo.y, b.lo.z}}, {"hi", {b.hi.x, b.hi.y, b.hi.z}}};
+    j["volume"]["orientation"] = orientation_code(v);
     j["histogram"] = h.histogram;
     json presets = json::object();
     for (const auto& name : preset_names()) presets[name] = json::parse(to_json(preset(name)));

@@ -37,11 +37,12 @@ function fail(message) {
   process.exit(1);
 }
 function check(cond, message) { if (!cond) fail(message); else console.log(`ok - ${message}`); }
+const fmt = (x) => String(+x.toPrecision(4));
 
 // The server prints its URL once it listens ("lacuna viewer: http://127.0.0.1:PORT/ ...").
-function spawnServer(volume, tf, onStarted) {
+function spawnServer(volume, tf, onStarted, extra = []) {
   return new Promise((resolve, reject) => {
-    const s = spawn(args.lacuna, ['serve', volume, '--port', '0', '--tf', tf],
+    const s = spawn(args.lacuna, ['serve', volume, '--port', '0', '--tf', tf, ...extra],
                     { stdio: ['ignore', 'pipe', 'pipe'] });
     onStarted(s);
     let out = '';
@@ -60,7 +61,9 @@ const startServer = (volume) => spawnServer(volume, 'mr-default', (s) => { serve
 // written here): voxel i runs toward the patient's left, j posterior, k superior; in world
 // (RAS mm, centred on 0) a faint body (50), a marker on the patient's right (220), one in front
 // (160), one on top (100). Mirrored or permuted handling shows as another picture.
-function writeLpsPhantom(path) {
+// With `labels`, the phantom's label map instead (same grid): 1 the right marker (> 200), 2 the
+// front one (> 140), 3 the top one (> 80), 0 elsewhere.
+function writeLpsPhantom(path, labels = false) {
   const [nx, ny, nz] = [41, 49, 37], sp = [1, 1.25, 1.5];
   // LPS position of voxel (0,0,0), RAS (20, 30, -27): the right-anterior-inferior corner.
   const origin = [-20, -30, -27];
@@ -74,7 +77,8 @@ function writeLpsPhantom(path) {
     v = Math.max(v, bump(Math.hypot(x - 11, y + 2, z), 5, 220));
     v = Math.max(v, bump(Math.hypot(x, y - 17, z + 4), 4.5, 160));
     v = Math.max(v, bump(Math.hypot(x + 3, y + 4, z - 16), 4.5, 100));
-    data[(k * ny + j) * nx + i] = Math.round(v);
+    v = Math.round(v);
+    data[(k * ny + j) * nx + i] = labels ? (v > 200 ? 1 : v > 140 ? 2 : v > 80 ? 3 : 0) : v;
   }
   const header = 'NRRD0004\ntype: uint8\ndimension: 3\nspace: left-posterior-superior\n' +
     `sizes: ${nx} ${ny} ${nz}\nspace directions: (${sp[0]},0,0) (0,${sp[1]},0) (0,0,${sp[2]})\n` +
@@ -120,11 +124,108 @@ try {
   page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => consoleErrors.push(String(e)));
 
+  // The page's slice messages, as they went over its WebSocket.
+  const slicesSent = [];
+  page.on('websocket', (ws) => ws.on('framesent', (f) => {
+    if (typeof f.payload !== 'string') return;
+    const m = JSON.parse(f.payload);
+    if (m.type === 'slice') slicesSent.push(m);
+  }));
   await page.goto(url);
   await waitFullFrame(page, 0);
   check(true, 'the page shows a frame');
   const accels = await page.$$eval('#accel option', (os) => os.map((o) => o.value));
   check(accels.includes('bitfield') && accels.includes('none'), `accel selector lists ${accels.join(', ')}`);
+
+  // Slice panes (issue 18 item 1): the three planes come from the server through `slice`
+  // messages; a click in one moves the crosshair there, the other two are fetched through the new
+  // point and the probe readout follows; window/level (shift-drag, the preset menu) changes the
+  // pictures. Without --labels the segments and overlay rows stay hidden.
+  {
+    const planes = ['axial', 'coronal', 'sagittal'];
+    const slices = () => page.evaluate(() => window.lacunaViewer.slices());
+    const settled = () => page.waitForFunction(() => {
+      const s = window.lacunaViewer.slices();
+      return ['axial', 'coronal', 'sagittal'].every((p) => s[p].count > 0 && s[p].settled);
+    }, null, { timeout: 30_000 });
+    const paneShot = (plane) => page.locator(`#pane-${plane} canvas`).screenshot();
+    await settled();
+    let sl = await slices();
+    check(planes.every((p) => sl[p].header.plane === p && sl[p].header.width > 1 && sl[p].header.height > 1),
+          `the three slice panes show slices (${planes.map((p) => `${sl[p].header.width}x${sl[p].header.height}`).join(', ')})`);
+    check(planes.every((p) => slicesSent.some((m) => m.plane === p)), 'the panes ask with slice messages');
+    const display = await page.evaluate(() => ['segments-row', 'overlay-row'].map(
+        (id) => getComputedStyle(document.getElementById(id)).display));
+    check(display.every((d) => d === 'none'), `without --labels the segments and overlay rows are hidden (${display})`);
+    await page.waitForFunction(() => window.lacunaViewer.probe() !== null, null, { timeout: 30_000 });
+    const readout0 = await page.textContent('#probe');
+
+    // Click at a pixel off the crosshair in the axial pane.
+    const ax = sl.axial.header;
+    const c = Math.round(ax.width * 0.3), r = Math.round(ax.height * 0.65);
+    const want = [0, 1, 2].map((a) => ax.origin[a] + c * ax.u[a] + r * ax.v[a]);
+    const before = await page.evaluate(() => window.lacunaViewer.state.point);
+    const at = await page.evaluate(([c, r]) => window.lacunaViewer.sliceClient('axial', c, r), [c, r]);
+    await page.mouse.click(at.x, at.y);
+    const point = await page.evaluate(() => window.lacunaViewer.state.point);
+    // The mouse lands within half a CSS pixel of the pixel's centre: less than a slice pixel here.
+    const off = Math.hypot(point[0] - want[0], point[1] - want[1]);
+    check(off <= ax.pixel_mm && Math.abs(point[2] - before[2]) < 1e-9,
+          `the click moves the crosshair to the clicked pixel (${point.map((x) => x.toFixed(2))}, ${off.toFixed(3)} mm off; z kept)`);
+    await settled();
+    sl = await slices();
+    check(['coronal', 'sagittal'].every((p) => JSON.stringify(sl[p].point) === JSON.stringify(point)),
+          'the coronal and sagittal panes are fetched through the new point');
+    check(Math.abs(sl.coronal.header.origin[1] - point[1]) < 1e-6 && Math.abs(sl.sagittal.header.origin[0] - point[0]) < 1e-6,
+          `their planes pass through it (coronal y ${sl.coronal.header.origin[1]}, sagittal x ${sl.sagittal.header.origin[0]})`);
+    // The crosshair is drawn at the click in the axial pane, in its colour.
+    const cross = await page.evaluate(() => {
+      const cv = document.querySelector('#pane-axial canvas');
+      const [x, y] = window.lacunaViewer.crosshairCanvas('axial');
+      const f = window.lacunaViewer.slices().axial.fit;
+      const px = cv.getContext('2d').getImageData(x, f.oy + 2, 1, 1).data;
+      return { x, y, rgb: [px[0], px[1], px[2]] };
+    });
+    const rect = await page.locator('#pane-axial canvas').boundingBox();
+    const cw = await page.evaluate(() => document.querySelector('#pane-axial canvas').width);
+    const k = cw / rect.width;
+    check(Math.abs(cross.x - (at.x - rect.x) * k) <= 1.5 && Math.abs(cross.y - (at.y - rect.y) * k) <= 1.5 &&
+          cross.rgb.join() === '255,204,0', `the axial crosshair is drawn at the click (${cross.x}, ${cross.y}: ${cross.rgb})`);
+    await page.waitForFunction((p) => {
+      const pr = window.lacunaViewer.probe();
+      return pr && JSON.stringify(pr.point) === JSON.stringify(p);
+    }, point, { timeout: 30_000 });
+    const probe = await page.evaluate(() => window.lacunaViewer.probe());
+    const readout = await page.textContent('#probe');
+    check(readout !== readout0 && probe.inside && readout.includes(`voxel [${probe.voxel.join(', ')}]`) &&
+          readout.includes(point[0].toFixed(1)) &&
+          probe.voxel.every((v, a) => v === Math.floor(probe.index[a] + 0.5)),
+          `the probe readout follows: "${readout.replace(/\n/g, ' | ')}"`);
+
+    // Shift-drag in the axial pane (the tree's central plane: 2% of it is the tree, the rest
+    // 0 and black under any window): window and level change, the picture too, the point stays.
+    const ax0 = await paneShot('axial');
+    const wl0 = await page.evaluate(() => [window.lacunaViewer.state.window, window.lacunaViewer.state.level]);
+    const box = await page.locator('#pane-axial').boundingBox();
+    await page.keyboard.down('Shift');
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.down();
+    await page.mouse.move(box.x + box.width / 2 - 60, box.y + box.height / 2 + 40, { steps: 6 });
+    await page.mouse.up();
+    await page.keyboard.up('Shift');
+    const st = await page.evaluate(() => window.lacunaViewer.state);
+    check(st.window < wl0[0] && st.level > wl0[1] && st.wlPreset === 'custom' &&
+          JSON.stringify(st.point) === JSON.stringify(point),
+          `shift-drag sets window/level (${wl0.map(fmt).join('/')} -> ${fmt(st.window)}/${fmt(st.level)}), the crosshair stays`);
+    await settled();
+    const ax1 = await paneShot('axial');
+    check(Buffer.compare(ax0, ax1) !== 0, 'window/level changes the slice');
+    await page.selectOption('#wl-preset', 'full');
+    const full = await page.evaluate(() => [window.lacunaViewer.state.window, window.lacunaViewer.hello().volume.data_range]);
+    check(Math.abs(full[0] - (full[1][1] - full[1][0])) < 1e-9, `the full-range preset sets the window to the data range (${fmt(full[0])})`);
+    await settled();
+    check(Buffer.compare(ax1, await paneShot('axial')) !== 0, 'and changes the slice again');
+  }
 
   // Drag the second opacity point of mr-default ((0.1, 0): where the ramp starts) upward.
   const img = page.locator('#frame');
@@ -189,9 +290,12 @@ try {
   // of `lacuna render --view V --clip ...` on the same file with the settings the page sent.
   {
     const phantom = join(dir, 'phantom-lps.nrrd'), tfFile = join(dir, 'phantom.json');
+    const labelFile = join(dir, 'phantom-labels.nrrd');
     writeLpsPhantom(phantom);
+    writeLpsPhantom(labelFile, true);
     writeFileSync(tfFile, JSON.stringify(kPhantomTf));
-    const url2 = await spawnServer(phantom, tfFile, (s) => { server2 = s; });
+    // With --labels (the frames below keep segments off, so they are `lacuna render`'s without).
+    const url2 = await spawnServer(phantom, tfFile, (s) => { server2 = s; }, ['--labels', labelFile]);
     const page3 = await context.newPage();
     page3.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
     page3.on('pageerror', (e) => consoleErrors.push(String(e)));
@@ -206,11 +310,81 @@ try {
       ws.on('framereceived', (f) => {
         if (typeof f.payload === 'string') return;
         const fr = parseFrame(Buffer.from(f.payload));
-        received.set(fr.header.id, fr);
+        if (fr.header.type === 'frame') received.set(fr.header.id, fr);  // not the slice panes'
       });
     });
     await page3.goto(url2);
     await waitFullFrame(page3, 0);
+    const rows = await page3.evaluate(() => ['segments-row', 'overlay-row'].map(
+        (id) => getComputedStyle(document.getElementById(id)).display));
+    check(rows.every((d) => d === 'flex'), `with --labels the segments and overlay rows show (${rows})`);
+    const setOverlay = (x) => page3.evaluate((x) => {
+      const el = document.getElementById('overlay-opacity');
+      el.value = String(x);
+      el.dispatchEvent(new Event('input'));
+    }, x);
+    await setOverlay(0);
+    // The slice panes in 3D Slicer's orientation on this file stored LPS: at the full range the
+    // brightest pixels are the right marker (220) on the screen's left in axial and coronal, and
+    // in sagittal the front marker (160), on the screen's left (the nose points left).
+    await page3.selectOption('#wl-preset', 'full');
+    const settled3 = () => page3.waitForFunction(() => {
+      const s = window.lacunaViewer.slices();
+      return ['axial', 'coronal', 'sagittal'].every((p) => s[p].count > 0 && s[p].settled);
+    }, null, { timeout: 30_000 });
+    const paneStats = () => page3.evaluate(() => {
+      const out = {};
+      for (const p of ['axial', 'coronal', 'sagittal']) {
+        const sl = window.lacunaViewer.slices()[p], f = sl.fit;
+        const w = Math.floor(f.s * sl.header.width), h = Math.floor(f.s * sl.header.height);
+        const d = document.querySelector(`#pane-${p} canvas`).getContext('2d').getImageData(f.ox, f.oy, w, h).data;
+        // grey: the JPEG's chroma keeps r, g, b within a few steps; the crosshair and the label
+        // colours (saturation 0.65) are far apart
+        const grey = (i) => Math.max(d[i], d[i + 1], d[i + 2]) - Math.min(d[i], d[i + 1], d[i + 2]) < 24;
+        let max = 0;
+        for (let i = 0; i < d.length; i += 4) if (grey(i)) max = Math.max(max, d[i]);
+        let n = 0, sx = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          if (grey(i) && d[i] >= 0.85 * max) { n++; sx += (i / 4) % w; }
+        }
+        let coloured = 0;  // label overlay pixels: neither grey nor the crosshair's exact yellow
+        for (let i = 0; i < d.length; i += 4) {
+          if (!grey(i) && !(d[i] === 255 && d[i + 1] === 204 && d[i + 2] === 0)) coloured++;
+        }
+        out[p] = { n, x: n ? sx / n / w : 0.5, max, coloured };
+      }
+      return out;
+    });
+    await settled3();
+    const brightest = await paneStats();
+    for (const [p, what] of [['axial', 'the right marker'], ['coronal', 'the right marker'], ['sagittal', 'the front marker']]) {
+      const b = brightest[p];
+      check(b.n > 0 && b.max > 100 && b.x < 0.4,
+            `${p} pane: ${what} on the screen's left (${b.n} px at ${b.x.toFixed(2)} of the width)`);
+    }
+    // The label overlay (opacity 0 so far: no coloured pixel) and the probe's label: a click on
+    // the right marker's centre (11, -2, 0) in the axial pane reads label 1.
+    await setOverlay(0.5);
+    await settled3();
+    const withOverlay = await paneStats();
+    check(brightest.axial.coloured === 0 && withOverlay.axial.coloured > 20,
+          `the overlay slider blends the labels over the slices (${brightest.axial.coloured} -> ${withOverlay.axial.coloured} coloured px)`);
+    const ax = (await page3.evaluate(() => window.lacunaViewer.slices())).axial.header;
+    const marker = [11, -2, 0], d = marker.map((x, a) => x - ax.origin[a]);
+    const dot3 = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const at = await page3.evaluate(([c, r]) => window.lacunaViewer.sliceClient('axial', c, r),
+                                    [dot3(d, ax.u) / dot3(ax.u, ax.u), dot3(d, ax.v) / dot3(ax.v, ax.v)]);
+    await page3.mouse.click(at.x, at.y);
+    await page3.waitForFunction(() => {
+      const pr = window.lacunaViewer.probe();
+      return pr && JSON.stringify(pr.point) === JSON.stringify(window.lacunaViewer.state.point);
+    }, null, { timeout: 30_000 });
+    const pr = await page3.evaluate(() => window.lacunaViewer.probe());
+    const readout = await page3.textContent('#probe');
+    check(pr.label === 1 && readout.includes('label 1') && pr.value > 200,
+          `the probe readout names the label under the crosshair: "${readout.replace(/\n/g, ' | ')}"`);
+    await setOverlay(0);
+    await settled3();
     // The newest full-resolution frame and the request it answers.
     const latest = () => {
       const id = Math.max(...[...received.values()].filter((f) => !f.header.preview).map((f) => f.header.id));

@@ -142,6 +142,15 @@ TEST(SliceServer, HelloListsTheNewMessages) {
     EXPECT_EQ(hello["messages"], json::array({"render", "slice", "probe"}));
     EXPECT_EQ(hello["slice_views"]["planes"], json::array({"axial", "coronal", "sagittal"}));
     EXPECT_EQ(hello["slice_views"]["interpolations"], json::array({"trilinear", "nearest"}));
+    // The world box the page centres its crosshair in: the phantom's, centred on 0 whatever
+    // the voxel order (stored LPS here).
+    const Box3f b = world_bounds(lps_phantom());
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_EQ(hello["volume"]["world_bounds"]["lo"][a].get<double>(), double(b.lo[a]));
+        EXPECT_EQ(hello["volume"]["world_bounds"]["hi"][a].get<double>(), double(b.hi[a]));
+        EXPECT_NEAR(double(b.lo[a] + b.hi[a]), 0.0, 1e-4);
+    }
+    EXPECT_EQ(hello["volume"]["orientation"], "LPS");
 }
 
 TEST(SliceServer, SliceOverTheWebSocketIsTheLibrarysSliceByteForByte) {
