@@ -40,6 +40,9 @@ void run(const VolumeArgs& args) {
     const ValueRange r = v.data_range(), vr = v.vis_range();
     std::printf("value range: %g .. %g\n", r.min, r.max);
     std::printf("vis range:   %g .. %g\n", vr.min, vr.max);
+    if (v.nan_voxels)
+        std::printf("NaN voxels:  %zu (%.2f%%), read as the minimum %g (background)\n", v.nan_voxels,
+                    100.0 * double(v.nan_voxels) / double(v.voxel_count()), r.min);
 
     // 16-bin histogram over the data range, plus the share of voxels at the minimum (background).
     // In double, as the viewer's histogram: voxels are finite (Volume::compute_range) and the

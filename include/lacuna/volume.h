@@ -89,6 +89,14 @@ public:
     // throws lacuna::Error(where, "voxel (i,j,k)", "NaN/Inf") on the first non-finite voxel and
     // lacuna::Error(where, "voxel values", ...) when max - min overflows float.
     void compute_range(const std::string& where = "volume");
+    // NaN voxels (float32 only) are background: resampled or masked MRI often holds NaN outside
+    // the brain. This replaces each by the smallest finite voxel value, so it renders as that
+    // value does (transparent under any TF whose opacity at the range minimum is zero: every
+    // built-in and Slicer preset), and returns how many it replaced (also kept in nan_voxels).
+    // Inf stays an error (compute_range). A volume of NaN only: lacuna::Error(where,
+    // "voxel values", ...). The file readers call it before compute_range (docs/formats.md).
+    size_t replace_nan_with_minimum(const std::string& where = "volume");
+    size_t nan_voxels = 0;
     ValueRange data_range() const { return m_data_range; }
     ValueRange vis_range() const { return m_vis_range; }
     // Overrides the visualization range; throws lacuna::Error if min >= max, not finite, or too

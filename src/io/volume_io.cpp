@@ -35,6 +35,7 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
                 v = io::read_itk(path, opts);
         }
         check_geometry(v, path);  // one world frame: no zero, singular or sheared axes
+        v.replace_nan_with_minimum(path);  // NaN is background (docs/formats.md)
         v.compute_range(path);
     } catch (const Error&) {
         throw;

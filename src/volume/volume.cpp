@@ -102,6 +102,28 @@ void Volume::set_value(int i, int j, int k, float v) {
     }
 }
 
+size_t Volume::replace_nan_with_minimum(const std::string& where) {
+    if (m_type != VoxelType::Float32) return 0;
+    float* p = data_as<float>();
+    const size_t n = voxel_count();
+    size_t nans = 0;
+    float lo = std::numeric_limits<float>::infinity();
+    for (size_t i = 0; i < n; ++i) {
+        if (std::isnan(p[i]))
+            ++nans;
+        else
+            lo = std::min(lo, p[i]);
+    }
+    if (nans == 0) return 0;
+    if (nans == n)
+        throw Error(where, "voxel values", "expected at least one voxel that is not NaN, got NaN only");
+    // (lo may be -Inf: then compute_range rejects the volume for its Inf, as without NaN.)
+    for (size_t i = 0; i < n; ++i)
+        if (std::isnan(p[i])) p[i] = lo;
+    nan_voxels = nans;
+    return nans;
+}
+
 void Volume::compute_range(const std::string& where) {
     const size_t n = voxel_count();
     float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();

@@ -417,15 +417,51 @@ TEST(IoMalformed, APairsHeaderNamedNiiIsRejected) {  // (pairs are read as .hdr 
 // ---------------------------------------------------------------------------------------------
 // Non-finite values
 
-TEST(IoMalformed, NanInFloatNiftiIsRejectedWithItsVoxel) {
+// NaN is background (docs/formats.md): each NaN voxel reads as the smallest finite value.
+TEST(IoMalformed, NanInFloatNiftiReadsAsTheMinimum) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.datatype = 16;
+    std::vector<float> vox = {3.f, -2.5f, 7.f, 1.f, 4.f, 0.f, 9.f, 2.f};
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<float> with_nan = vox;
+    with_nan[5] = nan;  // voxel (1,0,1)
+    with_nan[6] = nan;
+    test::write_bytes(dir.file("nan.nii.gz"),
+                      test::gzip(test::nifti_bytes(spec, with_nan.data(), with_nan.size() * 4)));
+    const Volume v = read_volume(dir.file("nan.nii.gz"));
+    EXPECT_EQ(v.nan_voxels, 2u);
+    // Brute force: the minimum over the voxels that are not NaN, in place of each NaN.
+    float lo = INFINITY;
+    for (float x : with_nan)
+        if (!std::isnan(x)) lo = std::min(lo, x);
+    ASSERT_EQ(lo, -2.5f);
+    for (int i = 0; i < 8; ++i) {
+        const float expect = std::isnan(with_nan[size_t(i)]) ? lo : with_nan[size_t(i)];
+        EXPECT_EQ(v.value(i & 1, i >> 1 & 1, i >> 2), expect) << "voxel " << i;
+    }
+    EXPECT_EQ(v.data_range().min, -2.5f);
+    EXPECT_EQ(v.data_range().max, 7.f);  // (9 was voxel 6, a NaN now)
+}
+
+TEST(IoMalformed, NanOnlyFloatNiftiIsRejected) {
+    ScratchDir dir;
+    NiftiSpec spec;
+    spec.datatype = 16;
+    std::vector<float> vox(8, std::numeric_limits<float>::quiet_NaN());
+    test::write_bytes(dir.file("allnan.nii"), test::nifti_bytes(spec, vox.data(), vox.size() * 4));
+    expect_read_error(dir.file("allnan.nii"), {"voxel values", "NaN only"});
+}
+
+TEST(IoMalformed, NanBesideInfIsStillRejectedForTheInf) {
     ScratchDir dir;
     NiftiSpec spec;
     spec.datatype = 16;
     std::vector<float> vox(8, 1.f);
-    vox[5] = std::numeric_limits<float>::quiet_NaN();  // voxel (1,0,1)
-    test::write_bytes(dir.file("nan.nii.gz"),
-                      test::gzip(test::nifti_bytes(spec, vox.data(), vox.size() * 4)));
-    expect_read_error(dir.file("nan.nii.gz"), {"NaN", "(1,0,1)"});
+    vox[2] = std::numeric_limits<float>::quiet_NaN();
+    vox[5] = std::numeric_limits<float>::infinity();  // voxel (1,0,1)
+    test::write_bytes(dir.file("naninf.nii"), test::nifti_bytes(spec, vox.data(), vox.size() * 4));
+    expect_read_error(dir.file("naninf.nii"), {"Inf", "(1,0,1)"});
 }
 
 TEST(IoMalformed, InfInFloatNrrdIsRejected) {
@@ -438,14 +474,16 @@ TEST(IoMalformed, InfInFloatNrrdIsRejected) {
     expect_read_error(dir.file("inf.nrrd"), {"Inf", "(2,2,2)"});
 }
 
-TEST(IoMalformed, NanInDoubleNrrdIsRejectedAfterConversion) {
+TEST(IoMalformed, NanInDoubleNrrdReadsAsTheMinimumAfterConversion) {
     ScratchDir dir;
     std::vector<double> vox(27, 2.0);
     vox[0] = std::numeric_limits<double>::quiet_NaN();
     std::string text = nrrd_header("double", "3 3 3");
     text.append(reinterpret_cast<const char*>(vox.data()), vox.size() * 8);
     test::write_text(dir.file("nan64.nrrd"), text);
-    expect_read_error(dir.file("nan64.nrrd"), {"NaN"});
+    const Volume v = read_volume(dir.file("nan64.nrrd"));  // NaN is background, as in NIfTI
+    EXPECT_EQ(v.nan_voxels, 1u);
+    EXPECT_EQ(v.value(0, 0, 0), 2.f);
 }
 
 // ---------------------------------------------------------------------------------------------
