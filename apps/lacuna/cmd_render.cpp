@@ -268,6 +268,18 @@ Setup validate(RenderArgs& a) {
     // --tf-animate takes a list of structures (render_animation); the frame carries the first.
     const std::string first = a.accel.substr(0, a.accel.find(','));
     f.structure = first == "all" ? Structure{structure::None{}} : structure_from(first, a, s);
+    // The TF's rendering (a Slicer preset's shading and gradient opacity, a MIP preset's blend)
+    // sets the features whose flags were not given, where the renderer takes them
+    // (apply_tf_rendering; docs/transfer-functions.md). A TF animation takes its first TF's.
+    if (f.renderer == Renderer::RayMarcher) {
+        if (!a.tf_animate.empty())
+            apply_tf_rendering(resolve_transfer_function(a.tf_animate[0]).rendering, f,
+                               a.features.given);
+        else if (!a.tf.empty()) {
+            a.tf_value = resolve_transfer_function(a.tf);
+            apply_tf_rendering(a.tf_value->rendering, f, a.features.given);
+        }
+    }
     validate_flags(f);
     return s;
 }
@@ -563,6 +575,8 @@ void register_render(CLI::App& app) {
         a->slice.map_given = cmd->count("--occlusion-map") > 0;
         a->slice.coalesce_given = cmd->count("--coalesce") > 0;
         a->azimuth_given = cmd->count("--azimuth") > 0;
+        a->features.given = {cmd->count("--shading") > 0, cmd->count("--phong") > 0,
+                             cmd->count("--gradient-opacity") > 0, cmd->count("--blend") > 0};
         a->elevation_given = cmd->count("--elevation") > 0;
         if (!a->session.empty()) {
             // The file is the frame: a flag that would change it is refused, not ignored.

@@ -33,6 +33,27 @@ std::vector<float> floats(const std::string& s, const char* flag, const char* wh
     return out;
 }
 
+// --gradient-opacity X:A,X:A,...: the points of a piecewise-linear factor (validate_features
+// checks their order and ranges).
+std::vector<GradientOpacityPoint> gradient_points(const std::string& s) {
+    std::vector<GradientOpacityPoint> out;
+    size_t pos = 0;
+    for (;;) {
+        const size_t c = s.find(',', pos);
+        const std::string tok = s.substr(pos, c == std::string::npos ? std::string::npos : c - pos);
+        const size_t colon = tok.find(':');
+        if (colon == std::string::npos)
+            throw Error("--gradient-opacity", "points",
+                        "expected X:A pairs separated by commas, got '" + s + "'");
+        const auto x = floats(tok.substr(0, colon), "--gradient-opacity", "points", 1);
+        const auto v = floats(tok.substr(colon + 1), "--gradient-opacity", "points", 1);
+        out.push_back({x[0], v[0]});
+        if (c == std::string::npos) break;
+        pos = c + 1;
+    }
+    return out;
+}
+
 }  // namespace
 
 void add_feature_args(CLI::App& cmd, FeatureArgs& a) {
@@ -44,7 +65,8 @@ void add_feature_args(CLI::App& cmd, FeatureArgs& a) {
                  "Precompute a gradient volume (12 bytes per voxel) instead of on-the-fly gradients")
         ->group(g);
     cmd.add_option("--gradient-opacity", a.gradient_opacity,
-                   "Gradient-magnitude opacity ramp LO,HI (values per mm): opacity x 0 below LO, x 1 above HI")
+                   "Gradient-magnitude opacity (|grad| in values per mm): a ramp LO,HI (opacity x 0 "
+                   "below LO, x 1 above HI), points X:A,X:A,... (piecewise linear), or none")
         ->group(g);
     cmd.add_option("--light", a.light,
                    "Light: head, dir:X,Y,Z (toward the light), spot:PX,PY,PZ,TX,TY,TZ[,CONE] (world mm, "
@@ -88,9 +110,16 @@ FeatureOptions parse_features(const FeatureArgs& a) {
         if (v.size() == 3) f.pbr.ambient = v[2];
     }
     f.gradient = a.gradient_volume ? GradientSource::Precomputed : GradientSource::OnTheFly;
-    if (!a.gradient_opacity.empty()) {
+    if (a.gradient_opacity == "none") {
+        f.gradient_opacity = {};
+    } else if (a.gradient_opacity.find(':') != std::string::npos) {
+        f.gradient_opacity.enabled = true;
+        f.gradient_opacity.points = gradient_points(a.gradient_opacity);
+    } else if (!a.gradient_opacity.empty()) {
         const auto v = floats(a.gradient_opacity, "--gradient-opacity", "ramp", 2);
-        f.gradient_opacity = {true, v[0], v[1]};
+        f.gradient_opacity.enabled = true;
+        f.gradient_opacity.lo = v[0];
+        f.gradient_opacity.hi = v[1];
     }
     if (a.light == "head") {
         f.light.kind = LightKind::Head;

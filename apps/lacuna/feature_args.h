@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lacuna/frame_spec.h"
 #include "lacuna/renderer.h"
 
 namespace lacuna::cli {
@@ -15,7 +16,7 @@ struct FeatureArgs {
     std::string shading = "none";
     std::string phong, pbr;       // "KA,KD,KS,POWER" / "ROUGHNESS,METALLIC[,AMBIENT]"
     bool gradient_volume = false;
-    std::string gradient_opacity; // "LO,HI"
+    std::string gradient_opacity; // "LO,HI", "X:A,X:A,..." or "none"
     std::string light = "head";   // head | dir:X,Y,Z | spot:PX,PY,PZ,TX,TY,TZ[,CONE]
     float light_intensity = 1.f;
     bool shadows = false, light_volume = false, unaccelerated_shadows = false;
@@ -27,6 +28,9 @@ struct FeatureArgs {
     std::string blend = "composite";
     bool jitter = false;
     uint32_t jitter_seed = 0;
+    // Which of the flags a TF's rendering defers to were on the command line (set by the
+    // subcommand from CLI11's counts; apply_tf_rendering, lacuna/frame_spec.h).
+    TfRenderingOverrides given;
 };
 
 void add_feature_args(CLI::App& cmd, FeatureArgs& a);

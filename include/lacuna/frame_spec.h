@@ -236,6 +236,28 @@ struct RendererCapabilities {
 const std::vector<RendererCapabilities>& capabilities();
 const RendererCapabilities& capabilities(Renderer r);
 
+// ---- A TF's rendering ---------------------------------------------------------------------------
+// A TF may carry the rendering it was made for (TfRendering, lacuna/transfer_function.h: 3D
+// Slicer's shading terms and gradient opacity, a MIP preset's blend). It is a default, not an
+// order: each part applies only where the user did not set the feature and the renderer takes it
+// (capabilities(); the slicer and the segment renderer take none of them).
+struct TfRenderingOverrides {  // true: the user set it, the TF's rendering leaves it alone
+    bool shading = false;           // the model (features.shading; the CLI's --shading)
+    bool phong = false;             // the Phong terms (features.phong; --phong)
+    bool gradient_opacity = false;  // features.gradient_opacity (--gradient-opacity)
+    bool blend = false;             // features.blend (--blend)
+};
+// Sets spec.features from r, part by part:
+//   r.shading           model Phong; terms ambient, diffuse, specular, specular power onto
+//                       PhongParams {ambient, diffuse, specular, power} one to one
+//   r.gradient_opacity  enabled with these points (x, a) -> GradientOpacityPoint; a function that
+//                       is 1 everywhere (Slicer's usual "0 1 255 1") multiplies by 1 and leaves
+//                       the feature off (off it costs nothing and changes no pixel)
+//   r.blend             the blend mode
+// Parts r leaves unset leave the spec's features as they are.
+void apply_tf_rendering(const TfRendering& r, FrameSpec& spec,
+                        const TfRenderingOverrides& given = {});
+
 // ---- Validation ---------------------------------------------------------------------------------
 // The error of validate() is FrameError (lacuna/error.h): its field() names the FrameSpec field.
 // Throws FrameError for the first field out of range or not taken by the renderer

@@ -50,13 +50,22 @@ enum class GradientSource {
     Precomputed,  // central differences per voxel stored as 3 floats, interpolated trilinearly
 };
 
-// Gradient-magnitude opacity modulation (VTK's gradient opacity): the TF opacity is multiplied
-// by a ramp of |grad| (voxel values per mm): 0 below `lo`, 1 above `hi`, linear between (with
-// lo == hi a step). Only multiplies, so the zero set of the modulated opacity contains that of
-// the TF: skipping on the TF's zero set stays exact.
+// Gradient-magnitude opacity (VTK's gradient opacity): the TF opacity is multiplied by a
+// piecewise-linear function g(|grad|) of the gradient magnitude (voxel values per mm), with the
+// TF's rules: linear between points, the end values outside them, and two points at one x a step
+// (g takes the second's value at x and right of it). `points` empty: the ramp (lo, 0), (hi, 1),
+// i.e. 0 below `lo`, 1 above `hi` (lo == hi a step), --gradient-opacity LO,HI. g only
+// multiplies, so the zero set of the modulated opacity contains that of the TF: skipping on the
+// TF's zero set stays exact, whatever the points.
+struct GradientOpacityPoint {
+    float x = 0.f;  // |grad|, voxel values per mm, >= 0
+    float a = 0.f;  // factor in [0,1]
+    friend bool operator==(const GradientOpacityPoint&, const GradientOpacityPoint&) = default;
+};
 struct GradientOpacity {
     bool enabled = false;
-    float lo = 0.f, hi = 1.f;
+    float lo = 0.f, hi = 1.f;                  // the ramp, when `points` is empty
+    std::vector<GradientOpacityPoint> points;  // sorted by x, at most two per x
 };
 
 enum class LightKind {
@@ -93,13 +102,7 @@ struct ClipPlane {
     float d = 0.f;
 };
 
-enum class BlendMode {
-    Composite,  // front-to-back emission-absorption (default)
-    Mip,        // TF colour and opacity of the largest sample value on the ray
-    MinIp,      // ... of the smallest sample value
-    Average,    // ... of the mean value of the samples with non-zero TF opacity
-};
-std::string to_string(BlendMode m);
+// BlendMode (composite, MIP, MinIP, average): lacuna/transfer_function.h.
 
 struct FeatureOptions {
     ShadingModel shading = ShadingModel::None;

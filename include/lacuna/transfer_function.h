@@ -54,6 +54,37 @@ struct OpacityPoint {
     friend bool operator==(const OpacityPoint&, const OpacityPoint&) = default;
 };
 
+// How a frame shows the volume's values after the TF (lacuna/renderer.h runs it; declared here
+// because a TF file may ask for one, TfRendering below).
+enum class BlendMode {
+    Composite,  // front-to-back emission-absorption (default)
+    Mip,        // TF colour and opacity of the largest sample value on the ray
+    MinIp,      // ... of the smallest sample value
+    Average,    // ... of the mean value of the samples with non-zero TF opacity
+};
+std::string to_string(BlendMode m);
+
+// Blinn-Phong terms as 3D Slicer's volume property holds them (vtkVolumeProperty: ambient,
+// diffuse, specular, specular power), mapped one to one onto lacuna's PhongParams.
+struct TfShading {
+    float ambient = 0.1f, diffuse = 0.7f, specular = 0.2f, specular_power = 10.f;
+    friend bool operator==(const TfShading&, const TfShading&) = default;
+};
+
+// The rendering a TF was made for, when its source says (3D Slicer's presets carry shading and a
+// gradient opacity beside their functions; the MIP presets want MIP). None of it changes the
+// LUT: a front end applies it to the frame's features the user did not set
+// (apply_tf_rendering, lacuna/frame_spec.h; the rule is in docs/transfer-functions.md).
+struct TfRendering {
+    std::optional<TfShading> shading;  // Phong with these terms; nullopt: unshaded
+    // Opacity factor over the gradient magnitude |grad| (voxel values per mm), piecewise linear
+    // as the TF's opacity (x sorted, a in [0,1], at most two points per x); empty: none.
+    std::vector<OpacityPoint> gradient_opacity;
+    std::optional<BlendMode> blend;  // nullopt: the frame's (composite by default)
+    bool empty() const { return !shading && gradient_opacity.empty() && !blend; }
+    friend bool operator==(const TfRendering&, const TfRendering&) = default;
+};
+
 struct TransferFunction {
     std::string name;
     TfDomain domain = TfDomain::Normalized;
@@ -61,6 +92,8 @@ struct TransferFunction {
     std::vector<OpacityPoint> opacity;  // sorted by x, at least one point
     // Optional visualization range carried by the TF file (values); overrides the volume's.
     std::optional<ValueRange> range;
+    // What the TF's file asks of the frame (JSON keys "shading", "gradient_opacity", "blend").
+    TfRendering rendering;
 };
 std::string to_string(const TransferFunction& tf);
 // Exact equality of every field (the JSON round trip is exact).
@@ -69,7 +102,8 @@ bool operator==(const TransferFunction& a, const TransferFunction& b);
 void PrintTo(const TransferFunction& tf, std::ostream* os);
 
 // Linear interpolation of two TFs with the same domain (bitfield paper, Section 4.5: the TF
-// animation). Control points are merged at the union of both x sets. w in [0,1].
+// animation). Control points are merged at the union of both x sets. w in [0,1]. The result
+// carries a's rendering (a TF animation keeps the look it starts with).
 TransferFunction lerp(const TransferFunction& a, const TransferFunction& b, float w);
 
 // RGBA per LUT entry; colour straight (not premultiplied), alpha per unit distance.
@@ -132,8 +166,11 @@ struct TransferLut {
 // piecewise-linear TF evaluated at the value vis.min + e*(vis.max-vis.min)/(size-1).
 TransferLut discretise(const TransferFunction& tf, ValueRange vis, int size = kDefaultLutSize);
 
-// Built-in presets (normalized domain): ct-bone, ct-skin, ct-soft-tissue, mr-default, mr-skin,
-// mr-brain, mr-gap. Throws lacuna::Error listing the valid names for an unknown one.
+// Built-in presets: lacuna's own in the normalized domain (ct-bone, ct-skin, ct-soft-tissue,
+// mr-default, mr-skin, mr-brain, mr-gap, label-band) and 3D Slicer's in the value domain with
+// their shading, gradient opacity and blend (CT-AAA, CT-Bone, CT-Lung, CT-Soft-Tissue, CT-MIP,
+// MR-Default, MR-Angio, MR-MIP; src/transfer/presets.cpp). Throws lacuna::Error listing the
+// valid names for an unknown one.
 TransferFunction preset(const std::string& name);
 std::vector<std::string> preset_names();
 

@@ -674,7 +674,9 @@ Request request_from(PySession& ps, py::kwargs kwargs) {
                                                          : lacuna::GradientSource::OnTheFly;
     if (kw.has("gradient_opacity")) {
         const auto v = kw.floats("gradient_opacity", 2);
-        ft.gradient_opacity = {true, v[0], v[1]};
+        ft.gradient_opacity.enabled = true;
+        ft.gradient_opacity.lo = v[0];
+        ft.gradient_opacity.hi = v[1];
     } else {
         kw.get("gradient_opacity");
     }

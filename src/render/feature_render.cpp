@@ -33,10 +33,21 @@ void validate_features(const FeatureOptions& f) {
     if (!(f.pbr.roughness > 0 && f.pbr.roughness <= 1) || !(f.pbr.metallic >= 0 && f.pbr.metallic <= 1) ||
         !(f.pbr.ambient >= 0 && std::isfinite(f.pbr.ambient)))
         fail("features.pbr", "expected roughness in (0,1], metallic in [0,1], ambient >= 0");
-    if (f.gradient_opacity.enabled &&
-        !(f.gradient_opacity.lo >= 0 && f.gradient_opacity.lo <= f.gradient_opacity.hi &&
-          std::isfinite(f.gradient_opacity.hi)))
+    const GradientOpacity& go = f.gradient_opacity;
+    if (go.enabled && go.points.empty() &&
+        !(go.lo >= 0 && go.lo <= go.hi && std::isfinite(go.hi)))
         fail("features.gradient_opacity", "expected 0 <= LO <= HI");
+    if (go.enabled)
+        for (size_t i = 0; i < go.points.size(); ++i) {
+            const GradientOpacityPoint& q = go.points[i];
+            if (!(q.x >= 0 && std::isfinite(q.x) && q.a >= 0 && q.a <= 1))
+                fail("features.gradient_opacity.points",
+                     "expected points (x, a) with finite x >= 0 and a in [0,1]");
+            if (i > 0 && q.x < go.points[i - 1].x)
+                fail("features.gradient_opacity.points", "expected points sorted by x");
+            if (i > 1 && q.x == go.points[i - 2].x)
+                fail("features.gradient_opacity.points", "expected at most two points per x (a step)");
+        }
     const Light& l = f.light;
     if (!(l.intensity >= 0 && std::isfinite(l.intensity)))
         fail("features.light.intensity", "expected a finite intensity >= 0");

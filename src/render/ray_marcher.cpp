@@ -69,15 +69,6 @@ std::string to_string(LightKind k) {
     return "?";
 }
 
-std::string to_string(BlendMode m) {
-    switch (m) {
-        case BlendMode::Composite: return "composite";
-        case BlendMode::Mip: return "mip";
-        case BlendMode::MinIp: return "minip";
-        case BlendMode::Average: return "average";
-    }
-    return "?";
-}
 
 TransferLut union_lut(const TransferLut& a, const TransferLut& b) {
     if (a.size() != b.size() || a.vis.min != b.vis.min || a.vis.max != b.vis.max)

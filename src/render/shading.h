@@ -9,6 +9,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "core/spec_pow.h"
 #include "lacuna/math.h"
@@ -126,11 +127,27 @@ inline float spot_factor(float cos_angle, float cone_deg) {
     return x * x * (3.f - 2.f * x);
 }
 
-// VTK-style gradient opacity ramp over |grad|.
+// g(|grad|) of GradientOpacity (lacuna/renderer.h): the piecewise-linear factor over n >= 1
+// points sorted by x. Written lo.a + (hi.a - lo.a) * ((mag - lo.x) / (hi.x - lo.x)) so that
+//   - the ramp (lo, 0), (hi, 1) gives bit for bit the old ramp's (mag - lo) / (hi - lo)
+//     (0 + 1 * t is t in float), so --gradient-opacity LO,HI images did not change;
+//   - a stretch between two equal factors returns that factor exactly (0 * t is 0), so a zero
+//     stretch is exactly zero and a stretch of ones exactly one.
+// The scan is linear: presets have 2..6 points. No allocation (the kernel calls it per sample).
+inline float gradient_opacity(const GradientOpacityPoint* p, size_t n, float mag) {
+    if (mag < p[0].x) return p[0].a;  // left of the first point: its value
+    size_t i = 1;                     // the first point strictly right of mag
+    while (i < n && p[i].x <= mag) ++i;
+    if (i == n) return p[n - 1].a;  // at or right of the last point: its value
+    const GradientOpacityPoint& lo = p[i - 1];
+    const GradientOpacityPoint& hi = p[i];  // lo.x <= mag < hi.x: a positive width
+    return lo.a + (hi.a - lo.a) * ((mag - lo.x) / (hi.x - lo.x));
+}
+
 inline float gradient_opacity(const GradientOpacity& g, float mag) {
-    if (mag >= g.hi) return 1.f;
-    if (mag <= g.lo) return g.lo == g.hi ? (mag >= g.hi ? 1.f : 0.f) : 0.f;
-    return (mag - g.lo) / (g.hi - g.lo);
+    if (!g.points.empty()) return gradient_opacity(g.points.data(), g.points.size(), mag);
+    const GradientOpacityPoint ramp[2] = {{g.lo, 0.f}, {g.hi, 1.f}};
+    return gradient_opacity(ramp, 2, mag);
 }
 
 }  // namespace lacuna::shading

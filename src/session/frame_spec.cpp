@@ -171,6 +171,27 @@ const std::vector<RendererCapabilities>& capabilities() {
 
 const RendererCapabilities& capabilities(Renderer r) { return capabilities()[size_t(r)]; }
 
+// ---- A TF's rendering ---------------------------------------------------------------------------
+void apply_tf_rendering(const TfRendering& r, FrameSpec& spec, const TfRenderingOverrides& given) {
+    const RendererCapabilities& caps = capabilities(spec.renderer);
+    FeatureOptions& f = spec.features;
+    if (r.shading && caps.has(Feature::Shading)) {
+        if (!given.shading) f.shading = ShadingModel::Phong;
+        if (!given.phong)
+            f.phong = {r.shading->ambient, r.shading->diffuse, r.shading->specular,
+                       r.shading->specular_power};
+    }
+    const bool identity = std::all_of(r.gradient_opacity.begin(), r.gradient_opacity.end(),
+                                      [](const OpacityPoint& p) { return p.a == 1.f; });
+    if (!identity && !given.gradient_opacity && caps.has(Feature::GradientOpacity)) {
+        f.gradient_opacity = {};
+        f.gradient_opacity.enabled = true;
+        for (const OpacityPoint& p : r.gradient_opacity)
+            f.gradient_opacity.points.push_back({float(p.x), p.a});
+    }
+    if (r.blend && !given.blend && caps.has(Feature::Blend)) f.blend = *r.blend;
+}
+
 // ---- Validation ---------------------------------------------------------------------------------
 namespace {
 

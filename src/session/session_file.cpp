@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -86,6 +87,18 @@ json structure_json(const Structure& s) {
     return j;
 }
 
+// The ramp as it always was ({"enabled", "lo", "hi"}: files without points keep their bytes);
+// piecewise-linear factors add "points": [[x, a], ...].
+json gradient_opacity_json(const GradientOpacity& g) {
+    json j = {{"enabled", g.enabled}, {"lo", g.lo}, {"hi", g.hi}};
+    if (!g.points.empty()) {
+        json pts = json::array();
+        for (const GradientOpacityPoint& p : g.points) pts.push_back(json::array({p.x, p.a}));
+        j["points"] = pts;
+    }
+    return j;
+}
+
 json features_json(const FeatureOptions& f) {
     json planes = json::array();
     for (const ClipPlane& p : f.clip_planes) planes.push_back({{"normal", vec(p.normal)}, {"d", p.d}});
@@ -96,8 +109,7 @@ json features_json(const FeatureOptions& f) {
         {"pbr", {{"roughness", f.pbr.roughness}, {"metallic", f.pbr.metallic},
                  {"ambient", f.pbr.ambient}}},
         {"gradient", name_of(kGradients, f.gradient)},
-        {"gradient_opacity", {{"enabled", f.gradient_opacity.enabled},
-                              {"lo", f.gradient_opacity.lo}, {"hi", f.gradient_opacity.hi}}},
+        {"gradient_opacity", gradient_opacity_json(f.gradient_opacity)},
         {"light", {{"kind", name_of(kLights, f.light.kind)}, {"direction", vec(f.light.direction)},
                    {"position", vec(f.light.position)}, {"target", vec(f.light.target)},
                    {"cone_deg", f.light.cone_deg}, {"intensity", f.light.intensity}}},
@@ -325,10 +337,27 @@ FeatureOptions read_features(const Reader& r) {
     r.get("gradient", f.gradient, kGradients);
     if (r.has("gradient_opacity")) {
         const Reader g = r.at("gradient_opacity");
-        g.expect_object({"enabled", "lo", "hi"});
+        g.expect_object({"enabled", "lo", "hi", "points"});
         g.get("enabled", f.gradient_opacity.enabled);
         g.get("lo", f.gradient_opacity.lo);
         g.get("hi", f.gradient_opacity.hi);
+        if (g.has("points")) {
+            // [[x, a], ...]; their order and ranges are validate()'s (features.gradient_opacity).
+            const Reader p = g.at("points");
+            const json& a = p.value();
+            if (!a.is_array() || a.empty())
+                p.fail(p.field(), "expected a non-empty array of [x, a] points, got " + a.dump());
+            for (size_t i = 0; i < a.size(); ++i) {
+                const json& q = a[i];
+                const std::string field = p.field() + "[" + std::to_string(i) + "]";
+                if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number())
+                    p.fail(field, "expected [x, a] (two numbers), got " + q.dump());
+                const double x = q[0].get<double>(), v = q[1].get<double>();
+                if (!(std::abs(x) <= 3.4028234663852886e38 && std::abs(v) <= 3.4028234663852886e38))
+                    p.fail(field, "expected finite floats, got " + q.dump());
+                f.gradient_opacity.points.push_back({float(x), float(v)});
+            }
+        }
     }
     if (r.has("light")) {
         const Reader l = r.at("light");

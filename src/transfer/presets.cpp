@@ -1,9 +1,10 @@
 // Built-in transfer functions and the "--tf" resolver. One line per preset in
 // docs/transfer-functions.md; keep the two in step.
 //
-// All presets are in the normalized domain: x = 0 is the visualization range's minimum, x = 1
-// its maximum. Each has exactly zero opacity below x = 0.1 (background air), so empty-space
+// lacuna's own presets are in the normalized domain: x = 0 is the visualization range's minimum,
+// x = 1 its maximum. Each has exactly zero opacity below x = 0.1 (background air), so empty-space
 // skipping always has something to skip. Opacity is per unit sample distance (one voxel).
+// 3D Slicer's (the capitalised names, below) are in the value domain, with Slicer's values.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -150,6 +151,61 @@ TransferFunction label_band() {
                 {{0.0, 0.f}, {0.34, 0.f}, {0.34, 0.8f}, {0.39, 0.8f}, {0.39, 0.f}, {1.0, 0.f}});
 }
 
+// ---- 3D Slicer's presets ------------------------------------------------------------------------
+// Eight of the presets 3D Slicer ships (Modules/Loadable/VolumeRendering/Resources/presets.xml,
+// Slicer's BSD-style licence), their attributes copied as Slicer writes them and read by the
+// same parser as any presets.xml (slicer_presets.h): value domain (CT in HU, MR in the scanner's
+// units), shading and gradient opacity as the TF's rendering. Slicer keeps the blend mode in the
+// view, not the preset; the two MIP presets are meant for MIP, so they carry blend "mip". Slicer's
+// gradient opacity of these eight is 1 for every magnitude (no effect; apply_tf_rendering leaves
+// the feature off), kept so the JSON says what Slicer says.
+constexpr const char* kSlicerXml = R"(<MRML>
+  <VolumeProperty name="CT-AAA" interpolation="1" shade="1" ambient="0.1" diffuse="0.9" specular="0.2" specularPower="10"
+    scalarOpacity="12 -3024 0 143.556 0 166.222 0.686275 214.389 0.696078 419.736 0.833333 3071 0.803922"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="24 -3024 0 0 0 143.556 0.615686 0.356863 0.184314 166.222 0.882353 0.603922 0.290196 214.389 1 1 1 419.736 1 0.937033 0.954531 3071 0.827451 0.658824 1"/>
+  <VolumeProperty name="CT-Bone" interpolation="1" shade="1" ambient="0.1" diffuse="0.9" specular="0.2" specularPower="10"
+    scalarOpacity="8 -3024 0 -16.4458 0 641.385 0.715686 3071 0.705882"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="16 -3024 0 0 0 -16.4458 0.729412 0.254902 0.301961 641.385 0.905882 0.815686 0.552941 3071 1 1 1"/>
+  <VolumeProperty name="CT-Lung" interpolation="1" shade="1" ambient="0.2" diffuse="1" specular="0" specularPower="1"
+    scalarOpacity="12 -1000 0 -600 0 -599 0.15 -400 0.15 -399 0 2952 0"
+    gradientOpacity="6 0 1 985.12 1 988 1"
+    colorTransfer="24 -1000 0.3 0.3 1 -600 0 0 1 -530 0.134704 0.781726 0.0724558 -460 0.929244 1 0.109473 -400 0.888889 0.254949 0.0240258 2952 1 0.3 0.3"/>
+  <VolumeProperty name="CT-Soft-Tissue" interpolation="1" shade="0" ambient="0.2" diffuse="1" specular="0" specularPower="1"
+    scalarOpacity="10 -2048 0 -167.01 0 -160 1 240 1 3661 1"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="20 -2048 0 0 0 -167.01 0 0 0 -160 0.0556356 0.0556356 0.0556356 240 1 1 1 3661 1 1 1"/>
+  <VolumeProperty name="CT-MIP" interpolation="1" shade="1" ambient="0.1" diffuse="0.9" specular="0.2" specularPower="10"
+    scalarOpacity="8 -3024 0 -637.62 0 700 1 3071 1"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="16 -3024 0 0 0 -637.62 1 1 1 700 1 1 1 3071 1 1 1"/>
+  <VolumeProperty name="MR-Default" interpolation="1" shade="1" ambient="0.2" diffuse="1" specular="0" specularPower="1"
+    scalarOpacity="12 0 0 20 0 40 0.15 120 0.3 220 0.375 1024 0.5"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="24 0 0 0 0 20 0.168627 0 0 40 0.403922 0.145098 0.0784314 120 0.780392 0.607843 0.380392 220 0.847059 0.835294 0.788235 1024 1 1 1"/>
+  <VolumeProperty name="MR-Angio" interpolation="1" shade="1" ambient="0.2" diffuse="1" specular="0" specularPower="1"
+    scalarOpacity="12 -2048 0 151.354 0 158.279 0.4375 190.112 0.580357 200.873 0.732143 3661 0.741071"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="24 -2048 0 0 0 151.354 0 0 0 158.279 0.74902 0.376471 0 190.112 1 0.866667 0.733333 200.873 0.937255 0.937255 0.937255 3661 1 1 1"/>
+  <VolumeProperty name="MR-MIP" interpolation="1" shade="0" ambient="0.2" diffuse="1" specular="0" specularPower="1"
+    scalarOpacity="8 0 0 98.3725 0 416.637 1 2800 1"
+    gradientOpacity="4 0 1 255 1"
+    colorTransfer="16 0 1 1 1 98.3725 1 1 1 416.637 1 1 1 2800 1 1 1"/>
+)</MRML>)";
+
+TransferFunction slicer_builtin(const char* name) {
+    static const std::vector<SlicerVolumeProperty> props =
+        parse_slicer_presets_xml(kSlicerXml, "built-in Slicer presets");
+    for (const SlicerVolumeProperty& p : props) {
+        if (p.name != name) continue;
+        TransferFunction tf = to_transfer_function(p);
+        if (p.name.ends_with("-MIP")) tf.rendering.blend = BlendMode::Mip;
+        return tf;
+    }
+    throw Error("built-in Slicer presets", name, "missing");  // a bug in the table below
+}
+
 struct PresetEntry {
     const char* name;
     TransferFunction (*make)();
@@ -158,6 +214,14 @@ constexpr PresetEntry kPresets[] = {
     {"ct-bone", ct_bone},       {"ct-skin", ct_skin}, {"ct-soft-tissue", ct_soft_tissue},
     {"mr-default", mr_default}, {"mr-skin", mr_skin}, {"mr-brain", mr_brain},
     {"mr-gap", mr_gap},         {"label-band", label_band},
+    {"CT-AAA", [] { return slicer_builtin("CT-AAA"); }},
+    {"CT-Bone", [] { return slicer_builtin("CT-Bone"); }},
+    {"CT-Lung", [] { return slicer_builtin("CT-Lung"); }},
+    {"CT-Soft-Tissue", [] { return slicer_builtin("CT-Soft-Tissue"); }},
+    {"CT-MIP", [] { return slicer_builtin("CT-MIP"); }},
+    {"MR-Default", [] { return slicer_builtin("MR-Default"); }},
+    {"MR-Angio", [] { return slicer_builtin("MR-Angio"); }},
+    {"MR-MIP", [] { return slicer_builtin("MR-MIP"); }},
 };
 
 std::string joined_names() {

@@ -558,6 +558,11 @@ TransferFunction to_transfer_function(const SlicerVolumeProperty& p) {
     tf.color = p.color;
     tf.opacity = p.scalar_opacity;
     tf.range = p.effective_range;
+    // The rest of the volume property: the frame's defaults (apply_tf_rendering).
+    if (p.shading.shade)
+        tf.rendering.shading = TfShading{p.shading.ambient, p.shading.diffuse, p.shading.specular,
+                                         p.shading.specular_power};
+    if (p.gradient_opacity_enabled) tf.rendering.gradient_opacity = p.gradient_opacity;
     tf_detail::validate(tf, p.source + "#" + p.name);
     return tf;
 }

@@ -20,8 +20,9 @@
 // Conversion (to_transfer_function): domain "value" with the points unchanged; the effective
 // range, when present, becomes the TF's range (the LUT is discretised over it and values outside
 // clamp to its ends, which is exactly "constant outside"). Without it, the volume's visualization
-// range is used, as for any value-domain TF. Gradient opacity and shading are not part of a
-// lacuna TF: they stay in SlicerVolumeProperty for the shading code to use.
+// range is used, as for any value-domain TF. Shading (when shade is on) and gradient opacity
+// (unless disabled) become the TF's rendering (TfRendering): defaults for the frame's features
+// that the user did not set (apply_tf_rendering, lacuna/frame_spec.h).
 //
 // Every malformed entry is one lacuna::Error: "<file>: <entry and field>: expected ..., got ...".
 #pragma once

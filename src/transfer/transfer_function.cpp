@@ -74,6 +74,31 @@ void validate(const TransferFunction& tf, const std::string& where) {
     validate_points(tf.color, tf.domain, where, "color", "[x, r, g, b] with r, g, b in [0,1]");
     validate_points(tf.opacity, tf.domain, where, "opacity", "[x, a] with a in [0,1]");
     if (tf.range) check_lut_range(*tf.range, kDefaultLutSize, where, "range");
+    const TfRendering& r = tf.rendering;
+    if (r.shading) {
+        const TfShading& s = *r.shading;
+        if (!(unit(s.ambient) && unit(s.diffuse) && unit(s.specular)) ||
+            !(s.specular_power >= 0.f && std::isfinite(s.specular_power)))
+            throw Error(where, "shading",
+                        "expected ambient, diffuse, specular in [0,1] and a finite specular_power "
+                        ">= 0, got " + shading_text(s));
+    }
+    if (!r.gradient_opacity.empty()) {
+        // Its x is a gradient magnitude (values per mm) whatever the TF's domain: >= 0.
+        validate_points(r.gradient_opacity, TfDomain::Value, where, "gradient_opacity",
+                        "[x, a] with a in [0,1]");
+        for (size_t i = 0; i < r.gradient_opacity.size(); ++i)
+            if (!(r.gradient_opacity[i].x >= 0.0))
+                throw Error(where, "gradient_opacity[" + std::to_string(i) + "]",
+                            "expected x >= 0 (a gradient magnitude), got " +
+                                point_text(r.gradient_opacity[i]));
+    }
+}
+
+std::string shading_text(const TfShading& s) {
+    return "{\"ambient\": " + float_text(s.ambient) + ", \"diffuse\": " + float_text(s.diffuse) +
+           ", \"specular\": " + float_text(s.specular) +
+           ", \"specular_power\": " + float_text(s.specular_power) + "}";
 }
 
 }  // namespace tf_detail
@@ -112,6 +137,16 @@ std::string tf_where(const TransferFunction& tf) {
 
 }  // namespace
 
+std::string to_string(BlendMode m) {
+    switch (m) {
+        case BlendMode::Composite: return "composite";
+        case BlendMode::Mip: return "mip";
+        case BlendMode::MinIp: return "minip";
+        case BlendMode::Average: return "average";
+    }
+    return "?";
+}
+
 std::string to_string(TfDomain d) {
     return d == TfDomain::Normalized ? "normalized" : "value";
 }
@@ -137,7 +172,17 @@ std::string to_string(const TransferFunction& tf) {
     for (size_t i = 0; i < tf.color.size(); ++i) s += (i ? ", " : "") + point_text(tf.color[i]);
     s += "], opacity=[";
     for (size_t i = 0; i < tf.opacity.size(); ++i) s += (i ? ", " : "") + point_text(tf.opacity[i]);
-    return s + "]}";
+    s += "]";
+    const TfRendering& r = tf.rendering;
+    if (r.shading) s += ", shading=" + shading_text(*r.shading);
+    if (!r.gradient_opacity.empty()) {
+        s += ", gradient_opacity=[";
+        for (size_t i = 0; i < r.gradient_opacity.size(); ++i)
+            s += (i ? ", " : "") + point_text(r.gradient_opacity[i]);
+        s += "]";
+    }
+    if (r.blend) s += ", blend=" + to_string(*r.blend);
+    return s + "}";
 }
 
 bool operator==(const TransferFunction& a, const TransferFunction& b) {
@@ -146,7 +191,7 @@ bool operator==(const TransferFunction& a, const TransferFunction& b) {
         a.range.has_value() == b.range.has_value() &&
         (!a.range || (a.range->min == b.range->min && a.range->max == b.range->max));
     return a.name == b.name && a.domain == b.domain && a.color == b.color &&
-           a.opacity == b.opacity && ranges_equal;
+           a.opacity == b.opacity && ranges_equal && a.rendering == b.rendering;
 }
 
 void PrintTo(const TransferFunction& tf, std::ostream* os) {
@@ -177,6 +222,7 @@ TransferFunction lerp(const TransferFunction& a, const TransferFunction& b, floa
                : w == 1.f ? b.name
                           : "lerp(" + a.name + ", " + b.name + ", " + float_text(w) + ")";
     out.domain = a.domain;
+    out.rendering = a.rendering;
     out.color = tf_detail::blend(a.color, b.color, double(w));
     out.opacity = tf_detail::blend(a.opacity, b.opacity, double(w));
     if (a.range) {

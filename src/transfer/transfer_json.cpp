@@ -4,6 +4,7 @@
 // with the offending JSON quoted back) and leaves the cross-point rules (sorting, steps,
 // normalized x in [0,1]) to tf_detail::validate(), which in-memory TFs go through as well.
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
@@ -23,7 +25,14 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* kKnownKeys = "name, description, domain, range, color, opacity";
+constexpr const char* kKnownKeys =
+    "name, description, domain, range, color, opacity, shading, gradient_opacity, blend";
+constexpr std::array<const char*, 4> kShadingKeys = {"ambient", "diffuse", "specular",
+                                                     "specular_power"};
+constexpr std::pair<BlendMode, const char*> kBlends[] = {{BlendMode::Composite, "composite"},
+                                                         {BlendMode::Mip, "mip"},
+                                                         {BlendMode::MinIp, "minip"},
+                                                         {BlendMode::Average, "average"}};
 
 // A quoted, escaped JSON string; invalid UTF-8 is replaced rather than thrown on.
 std::string json_string(const std::string& s) {
@@ -143,6 +152,36 @@ std::vector<P> read_points(const json& doc, const char* key, const std::array<co
     return pts;
 }
 
+// "shading": {"ambient": .., "diffuse": .., "specular": .., "specular_power": ..}, every key
+// present and a number (the ranges are tf_detail::validate()'s).
+TfShading read_shading(const json& j, const std::string& where) {
+    const std::string shape =
+        "an object {\"ambient\", \"diffuse\", \"specular\", \"specular_power\"} of numbers";
+    if (!j.is_object()) throw Error(where, "shading", "expected " + shape + ", got " + brief(j));
+    for (const auto& [key, value] : j.items())
+        if (std::find_if(kShadingKeys.begin(), kShadingKeys.end(),
+                         [&](const char* k) { return key == k; }) == kShadingKeys.end())
+            throw Error(where, "shading." + key, "unknown key; expected " + shape);
+    float v[4];
+    for (size_t i = 0; i < 4; ++i) {
+        const std::string field = std::string("shading.") + kShadingKeys[i];
+        auto it = j.find(kShadingKeys[i]);
+        if (it == j.end()) throw Error(where, field, "missing; expected " + shape);
+        if (!it->is_number()) throw Error(where, field, "expected a number, got " + brief(*it));
+        v[i] = float(it->get<double>());
+    }
+    return {v[0], v[1], v[2], v[3]};
+}
+
+BlendMode read_blend(const json& j, const std::string& where) {
+    std::string names;
+    for (const auto& [mode, name] : kBlends) {
+        if (j.is_string() && j.get<std::string>() == name) return mode;
+        names += (names.empty() ? "\"" : ", \"") + std::string(name) + "\"";
+    }
+    throw Error(where, "blend", "expected one of " + names + ", got " + brief(j));
+}
+
 }  // namespace
 
 TransferFunction parse_transfer_function(const std::string& json_text, const std::string& where) {
@@ -176,7 +215,8 @@ TransferFunction parse_transfer_function(const std::string& json_text, const std
 
     for (const auto& [key, value] : doc.items()) {
         if (key != "name" && key != "description" && key != "domain" && key != "range" &&
-            key != "color" && key != "opacity")
+            key != "color" && key != "opacity" && key != "shading" && key != "gradient_opacity" &&
+            key != "blend")
             throw Error(where, json_string(key),
                         std::string("unknown key; expected one of: ") + kKnownKeys);
     }
@@ -226,6 +266,13 @@ TransferFunction parse_transfer_function(const std::string& json_text, const std
                                               [](const std::array<double, 2>& v) {
                                                   return OpacityPoint{v[0], float(v[1])};
                                               });
+    // The rendering the TF asks of the frame (TfRendering), each part optional.
+    if (auto it = doc.find("shading"); it != doc.end()) tf.rendering.shading = read_shading(*it, where);
+    if (doc.contains("gradient_opacity"))
+        tf.rendering.gradient_opacity = read_points<OpacityPoint, 2>(
+            doc, "gradient_opacity", {"x", "a"}, where, "a in [0,1]",
+            [](const std::array<double, 2>& v) { return OpacityPoint{v[0], float(v[1])}; });
+    if (auto it = doc.find("blend"); it != doc.end()) tf.rendering.blend = read_blend(*it, where);
 
     tf_detail::validate(tf, where);
     return tf;
@@ -261,7 +308,20 @@ std::string to_json(const TransferFunction& tf) {
     s += "  ],\n  \"opacity\": [\n";
     for (size_t i = 0; i < tf.opacity.size(); ++i)
         s += "    " + point_text(tf.opacity[i]) + (i + 1 < tf.opacity.size() ? ",\n" : "\n");
-    s += "  ]\n}\n";
+    s += "  ]";
+    const TfRendering& r = tf.rendering;
+    if (r.shading) s += ",\n  \"shading\": " + tf_detail::shading_text(*r.shading);
+    if (!r.gradient_opacity.empty()) {
+        s += ",\n  \"gradient_opacity\": [\n";
+        for (size_t i = 0; i < r.gradient_opacity.size(); ++i)
+            s += "    " + point_text(r.gradient_opacity[i]) +
+                 (i + 1 < r.gradient_opacity.size() ? ",\n" : "\n");
+        s += "  ]";
+    }
+    if (r.blend)
+        for (const auto& [mode, name] : kBlends)
+            if (mode == *r.blend) s += ",\n  \"blend\": \"" + std::string(name) + "\"";
+    s += "\n}\n";
     return s;
 }
 
