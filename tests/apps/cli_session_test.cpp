@@ -52,6 +52,10 @@ TEST(CliSession, SavedSessionRendersTheSameBytes) {
         "--background 0.1,0.2,0.3 --accel minmax --leaf 4",
         " --tf ct-bone --size 32 --shading phong --clip 1,0,0,0 --jitter --range 10:200 --fov 40",
         " --tf mr-default --size 32 --renderer slice --accel none",
+        // A piecewise gradient opacity, and a TF whose rendering set the features (Slicer's
+        // MR-Default: Phong 0.2,1,0,1): the file holds the resolved features and the TF.
+        " --tf mr-default --size 32 --gradient-opacity 0:0,4:0,4:0.5,30:1 --shading phong",
+        " --tf MR-Default --size 32 --accel bitfield",
     };
     int i = 0;
     for (const std::string& flags : cases) {
@@ -139,6 +143,18 @@ TEST(CliSession, MalformedFilesNameTheFieldAndWriteNothing) {
         {"segments", [](auto& j) { j["frame"]["renderer"] = "segments"; }, "frame.renderer"},
         {"background short", [](auto& j) { j["frame"]["background"] = {0, 0}; },
          "frame.background: expected an array of three numbers"},
+        {"gradient points not pairs",
+         [](auto& j) { j["frame"]["features"]["gradient_opacity"]["points"] = {{0, 0, 1}}; },
+         "frame.features.gradient_opacity.points[0]: expected [x, a]"},
+        {"gradient points unsorted",
+         [](auto& j) {
+             j["frame"]["features"]["gradient_opacity"] = {{"enabled", true}, {"lo", 0}, {"hi", 1},
+                                                          {"points", {{5, 0}, {1, 1}}}};
+         },
+         "features.gradient_opacity.points: expected points sorted by x"},
+        {"gradient points empty",
+         [](auto& j) { j["frame"]["features"]["gradient_opacity"]["points"] = nlohmann::json::array(); },
+         "frame.features.gradient_opacity.points: expected a non-empty array"},
     };
     int i = 0;
     for (const Case& c : cases) {
@@ -190,12 +206,19 @@ TEST(SessionFile, RoundTripIsExact) {
     s.frame.camera.orbit.target = {1e-7f, -3.4e38f, 12.5f};
     s.frame.sampling.early_termination = std::nullopt;
     s.frame.structure = lacuna::structure::KdTree{5, 2, 0.3f, 0.07f, 6};
+    s.frame.features.gradient_opacity.enabled = true;
+    s.frame.features.gradient_opacity.points = {{0.f, 0.f}, {2.5f, 0.f}, {2.5f, 1.f / 3.f}, {1e4f, 1.f}};
     const std::string text = lacuna::to_json(s);
     const lacuna::SessionFile t = lacuna::parse_session_file(text, "x.json");
     EXPECT_EQ(lacuna::to_json(t), text);
     EXPECT_EQ(t.frame.camera.orbit.target.y, -3.4e38f);
     EXPECT_EQ(t.frame.features.clip_planes.at(0).d, 1.f / 3.f);
     EXPECT_EQ(t.frame.structure, s.frame.structure);
+    EXPECT_EQ(t.frame.features.gradient_opacity.points, s.frame.features.gradient_opacity.points);
+    // Without points the gradient opacity is written as it always was: no "points" key.
+    lacuna::SessionFile ramp = s;
+    ramp.frame.features.gradient_opacity.points.clear();
+    EXPECT_EQ(lacuna::to_json(ramp).find("points"), std::string::npos);
     EXPECT_FALSE(t.frame.sampling.early_termination.has_value());
     EXPECT_EQ(t.tf, s.tf);
     EXPECT_EQ(*t.tf_back, *s.tf_back);

@@ -47,6 +47,23 @@ Light random_light(const Volume& v, Rng& rng, LightKind kind) {
     return l;
 }
 
+// 2..6 points over [0, 0.4 * (value width + 1)] per mm, sorted, one pair sharing an x (a step)
+// at random, factors 0, 1 or uniform: zero stretches, steps, interior maxima.
+GradientOpacity random_gradient_points(const Volume& v, Rng& r) {
+    GradientOpacity g;
+    g.enabled = true;
+    const float top = (v.data_range().width() + 1.f) * 0.4f;
+    const int n = r.range(2, 6);
+    float x = 0.f;
+    for (int i = 0; i < n; ++i) {
+        if (i == 0 || !r.coin() || (i >= 2 && g.points[size_t(i) - 2].x == x))
+            x += top / float(n) * (0.05f + r.uniform());
+        const int kind = r.range(0, 2);
+        g.points.push_back({x, kind == 0 ? 0.f : kind == 1 ? 1.f : r.uniform()});
+    }
+    return g;
+}
+
 std::vector<FeatureCase> feature_cases() {
     return {
         {"phong", [](FeatureOptions& f, const Volume&, Rng&) { f.shading = ShadingModel::Phong; }},
@@ -82,6 +99,17 @@ std::vector<FeatureCase> feature_cases() {
              f.shading = ShadingModel::Pbr;
              const float a = (v.data_range().width() + 1.f) * 0.2f * r.uniform();
              f.gradient_opacity = {true, a, 2.f * a};
+         }},
+        // Piecewise-linear factors over |grad|: random points (with a step and zero stretches,
+        // which must stay exactly zero), alone and with Phong as a shaded Slicer preset does.
+        {"gradient opacity points", [](FeatureOptions& f, const Volume& v, Rng& r) {
+             f.gradient_opacity = random_gradient_points(v, r);
+         }},
+        {"gradient opacity points + phong",
+         [](FeatureOptions& f, const Volume& v, Rng& r) {
+             f.shading = ShadingModel::Phong;
+             f.phong = {0.1f, 0.9f, 0.2f, 10.f};  // Slicer's CT-Bone terms
+             f.gradient_opacity = random_gradient_points(v, r);
          }},
         {"shadows directional",
          [](FeatureOptions& f, const Volume& v, Rng& r) {

@@ -545,6 +545,97 @@ TEST(Shading, GradientOpacityRemovesHomogeneousRegionsOnly) {
         EXPECT_LE(mod.rgba_float[i], plain.rgba_float[i] + 1e-6f);  // it only multiplies
 }
 
+// The factor by its definition, in double and by another route: the segment [x_i, x_{i+1})
+// holding m found by a scan from the right, the value as a weighted mean of the two ends.
+double gradient_factor_reference(const std::vector<GradientOpacityPoint>& p, double m) {
+    if (m < p.front().x) return p.front().a;
+    if (m >= p.back().x) return p.back().a;
+    size_t i = p.size() - 1;
+    while (!(p[i].x <= m)) --i;  // the last point at or left of m (right-continuous at steps)
+    const double w = (m - p[i].x) / (double(p[i + 1].x) - p[i].x);
+    return (1.0 - w) * p[i].a + w * p[i + 1].a;
+}
+
+TEST(Shading, GradientOpacityPointsMatchTheirDefinition) {
+    test::Rng rng(18);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<GradientOpacityPoint> pts;
+        float x = 100.f * rng.uniform();
+        const int n = rng.range(1, 7);
+        for (int i = 0; i < n; ++i) {
+            // Sometimes a step (two points at one x), never three.
+            const bool step = i >= 1 && rng.coin(3) && !(i >= 2 && pts[size_t(i) - 2].x == x);
+            if (i > 0 && !step) x += 1.f + 60.f * rng.uniform();
+            const int kind = rng.range(0, 3);
+            pts.push_back({x, kind == 0 ? 0.f : kind == 1 ? 1.f : rng.uniform()});
+        }
+        GradientOpacity g;
+        g.enabled = true;
+        g.points = pts;
+        for (int k = 0; k < 400; ++k) {
+            const float m = k < 2 * n ? pts[size_t(k / 2)].x  // at every point exactly
+                                      : (x + 80.f) * rng.uniform();
+            const float got = shading::gradient_opacity(g, m);
+            // Float error: m - x and the width (< 64, widths >= 1) each within ulp(64)/2 = 4e-6.
+            EXPECT_NEAR(got, gradient_factor_reference(pts, m), 1e-5) << "trial " << trial << " m " << m;
+            // Exact where the definition is exact: at the points' values and on flat stretches.
+            size_t i = 0;
+            while (i + 1 < pts.size() && pts[i + 1].x <= m) ++i;
+            const bool flat = m < pts.front().x || i + 1 == pts.size() || pts[i].a == pts[i + 1].a;
+            const float flat_value = m < pts.front().x ? pts.front().a : pts[i].a;
+            if (flat) EXPECT_EQ(got, flat_value) << "trial " << trial << " m " << m;
+        }
+    }
+}
+
+TEST(Shading, GradientOpacityRampIsItsTwoPointFunctionBitForBit) {
+    // --gradient-opacity LO,HI is the points (LO, 0), (HI, 1): the same float per magnitude as
+    // the ramp formula (m - lo) / (hi - lo), so images made with the ramp did not change.
+    test::Rng rng(7);
+    for (int trial = 0; trial < 100; ++trial) {
+        const float lo = 50.f * rng.uniform(), hi = trial % 10 == 0 ? lo : lo + 80.f * rng.uniform();
+        GradientOpacity ramp;
+        ramp.enabled = true;
+        ramp.lo = lo, ramp.hi = hi;
+        GradientOpacity pts = ramp;
+        pts.points = {{lo, 0.f}, {hi, 1.f}};
+        for (int k = 0; k < 200; ++k) {
+            const float m = 150.f * rng.uniform();
+            const float formula = m >= hi ? 1.f : m <= lo ? 0.f : (m - lo) / (hi - lo);
+            EXPECT_EQ(shading::gradient_opacity(ramp, m), formula) << lo << " " << hi << " " << m;
+            EXPECT_EQ(shading::gradient_opacity(pts, m), formula) << lo << " " << hi << " " << m;
+        }
+    }
+}
+
+TEST(Shading, GradientOpacityPointsRenderLikeTheRampTheyEqual) {
+    // (0, 0), (10, 0), (20, 1) is the ramp 10,20 with a zero stretch in front: the same image.
+    Volume v({24, 24, 24}, VoxelType::UInt8);
+    for (int z = 4; z < 20; ++z)
+        for (int y = 4; y < 20; ++y)
+            for (int x = 4; x < 20; ++x) v.set_value(x, y, z, 120.f + 4.f * float(x));
+    v.compute_range();
+    RayMarcher m(v);
+    m.set_transfer_function(step_lut(v, 100.f, {1, 0.8f, 0.6f, 0.3f}));
+    OrbitParams p;
+    p.azimuth_deg = 20, p.elevation_deg = 30;
+    const Camera cam = Camera::orbit(m.bounds(), p, 32, 32);
+    RenderOptions ro;
+    ro.keep_float = true;
+    ro.features.shading = ShadingModel::Phong;
+    ro.features.gradient_opacity.enabled = true;
+    ro.features.gradient_opacity.lo = 10.f;
+    ro.features.gradient_opacity.hi = 20.f;
+    const RenderResult ramp = m.render(cam, ro);
+    ro.features.gradient_opacity.points = {{0.f, 0.f}, {10.f, 0.f}, {20.f, 1.f}};
+    const RenderResult pts = m.render(cam, ro);
+    EXPECT_EQ(ramp.rgba_float, pts.rgba_float);
+    EXPECT_EQ(ramp.image.rgba, pts.image.rgba);
+    // And another function gives another image (the points are read).
+    ro.features.gradient_opacity.points = {{0.f, 1.f}, {10.f, 0.2f}};
+    EXPECT_NE(m.render(cam, ro).rgba_float, ramp.rgba_float);
+}
+
 TEST(Shading, LightVolumeIsRecomputedOnLightAndTfChangesOnly) {
     const Volume v = ball(21, 7.f);
     RayMarcher m(v);
@@ -589,6 +680,17 @@ TEST(Shading, InvalidOptionsThrow) {
     bad([](FeatureOptions& f) { f.light.kind = LightKind::Directional, f.light.direction = {0, 0, 0}; });
     bad([](FeatureOptions& f) { f.pbr.roughness = 0.f, f.shading = ShadingModel::Pbr; });
     bad([](FeatureOptions& f) { f.gradient_opacity = {true, 2.f, 1.f}; });
+    auto points = [](std::vector<GradientOpacityPoint> p) {
+        return [p](FeatureOptions& f) {
+            f.gradient_opacity.enabled = true;
+            f.gradient_opacity.points = p;
+        };
+    };
+    bad(points({{5.f, 0.f}, {1.f, 1.f}}));                // unsorted
+    bad(points({{1.f, 0.f}, {1.f, 0.5f}, {1.f, 1.f}}));   // three at one x
+    bad(points({{0.f, 0.f}, {1.f, 1.5f}}));               // a > 1
+    bad(points({{-1.f, 0.f}, {1.f, 1.f}}));               // x < 0
+    bad(points({{0.f, 0.f}, {INFINITY, 1.f}}));           // x not finite
     bad([](FeatureOptions& f) { f.shadows.step = 0.f; });
     // A back TF needs a plane, and the same LUT layout.
     TransferLut back = step_lut(v, 100.f);

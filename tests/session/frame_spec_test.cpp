@@ -375,3 +375,88 @@ TEST(Capabilities, EveryFeatureTheTableGrantsHasAnEffectAndEveryOtherIsRefused) 
 
 }  // namespace
 }  // namespace lacuna
+
+namespace lacuna {
+namespace {
+
+// A TF's rendering fills exactly the features the user left alone, and only where the renderer
+// takes them; each override keeps the user's value.
+TEST(TfRendering, SetsUnsetFeaturesAndLeavesTheUsersAlone) {
+    TfRendering r;
+    r.shading = TfShading{0.1f, 0.9f, 0.2f, 10.f};
+    r.gradient_opacity = {{0, 0.f}, {40, 1.f}};
+    r.blend = BlendMode::Mip;
+    const PhongParams preset_terms{0.1f, 0.9f, 0.2f, 10.f};
+    auto applied = [&](const TfRenderingOverrides& given, FrameSpec f = {}) {
+        apply_tf_rendering(r, f, given);
+        return f;
+    };
+    auto same_phong = [](const PhongParams& a, const PhongParams& b) {
+        return a.ambient == b.ambient && a.diffuse == b.diffuse && a.specular == b.specular &&
+               a.power == b.power;
+    };
+    // Nothing given: all of it.
+    FrameSpec f = applied({});
+    EXPECT_EQ(f.features.shading, ShadingModel::Phong);
+    EXPECT_TRUE(same_phong(f.features.phong, preset_terms));
+    EXPECT_TRUE(f.features.gradient_opacity.enabled);
+    EXPECT_EQ(f.features.gradient_opacity.points,
+              (std::vector<GradientOpacityPoint>{{0.f, 0.f}, {40.f, 1.f}}));
+    EXPECT_EQ(f.features.blend, BlendMode::Mip);
+    EXPECT_EQ(blamed(f), "");
+    // Each override alone keeps the user's value of that feature only.
+    FrameSpec user;
+    user.features.shading = ShadingModel::Pbr;
+    user.features.phong = {0.3f, 0.5f, 0.7f, 3.f};
+    user.features.gradient_opacity = {};  // "--gradient-opacity none"
+    user.features.blend = BlendMode::Composite;
+    f = applied({.shading = true}, user);
+    EXPECT_EQ(f.features.shading, ShadingModel::Pbr);
+    EXPECT_TRUE(same_phong(f.features.phong, preset_terms));  // the terms still default to r's
+    EXPECT_TRUE(f.features.gradient_opacity.enabled);
+    f = applied({.phong = true}, user);
+    EXPECT_EQ(f.features.shading, ShadingModel::Phong);
+    EXPECT_TRUE(same_phong(f.features.phong, user.features.phong));
+    f = applied({.gradient_opacity = true}, user);
+    EXPECT_FALSE(f.features.gradient_opacity.enabled);
+    EXPECT_EQ(f.features.blend, BlendMode::Mip);
+    f = applied({.blend = true}, user);
+    EXPECT_EQ(f.features.blend, BlendMode::Composite);
+    EXPECT_TRUE(f.features.gradient_opacity.enabled);
+    f = applied({true, true, true, true}, user);
+    EXPECT_EQ(f.features.shading, user.features.shading);
+    EXPECT_TRUE(same_phong(f.features.phong, user.features.phong));
+    EXPECT_FALSE(f.features.gradient_opacity.enabled);
+    EXPECT_EQ(f.features.blend, BlendMode::Composite);
+}
+
+TEST(TfRendering, OnlyWhereTheRendererTakesItAndNeverAnIdentityFactor) {
+    TfRendering r;
+    r.shading = TfShading{};
+    r.gradient_opacity = {{0, 0.f}, {40, 1.f}};
+    r.blend = BlendMode::Mip;
+    for (Renderer renderer : {Renderer::Slicer, Renderer::Segments}) {
+        FrameSpec f;
+        f.renderer = renderer;
+        f.structure = parse_structure("auto", renderer);
+        apply_tf_rendering(r, f);
+        EXPECT_EQ(f.features.shading, ShadingModel::None) << to_string(renderer);
+        EXPECT_FALSE(f.features.gradient_opacity.enabled) << to_string(renderer);
+        EXPECT_EQ(f.features.blend, BlendMode::Composite) << to_string(renderer);
+        EXPECT_EQ(blamed(f), "") << to_string(renderer);
+    }
+    // Slicer's usual "0 1 255 1" (1 everywhere) multiplies by 1: the feature stays off.
+    TfRendering ones;
+    ones.gradient_opacity = {{0, 1.f}, {255, 1.f}};
+    FrameSpec f;
+    apply_tf_rendering(ones, f);
+    EXPECT_FALSE(f.features.gradient_opacity.enabled);
+    EXPECT_EQ(f.features.shading, ShadingModel::None);
+    // An empty rendering changes nothing.
+    FrameSpec g;
+    apply_tf_rendering(TfRendering{}, g);
+    EXPECT_FALSE(g.features.any());
+}
+
+}  // namespace
+}  // namespace lacuna

@@ -109,8 +109,14 @@ TEST(SlicerPresets, ConvertsToTheSameTfAsOurJson) {
     const TransferFunction ours = load_transfer_function(kData + "lacuna-ct-bone-value.json");
     const TransferFunction slicer =
         resolve_transfer_function("slicer:" + kData + "slicer-presets.xml#Lacuna-CT-Bone");
-    EXPECT_EQ(slicer, ours);
+    EXPECT_EQ(slicer, ours);  // with the rendering: our JSON writes the shading terms too
     EXPECT_EQ(slicer.domain, TfDomain::Value);
+    // shade="1": the rendering holds the four terms as the file has them; the gradient
+    // opacity (1 at 0 and 900) is kept as written.
+    ASSERT_TRUE(slicer.rendering.shading);
+    EXPECT_EQ(*slicer.rendering.shading, (TfShading{0.15f, 0.8f, 0.3f, 20.f}));
+    EXPECT_EQ(slicer.rendering.gradient_opacity, (std::vector<OpacityPoint>{{0, 1.f}, {900, 1.f}}));
+    EXPECT_FALSE(slicer.rendering.blend);
     // The effective range wins over the volume's range, so both LUTs agree entry for entry.
     const TransferLut a = discretise(slicer, {0.f, 255.f}), b = discretise(ours, {0.f, 255.f});
     ASSERT_EQ(a.entries.size(), b.entries.size());
@@ -126,6 +132,14 @@ TEST(SlicerPresets, ConvertsToTheSameTfAsOurJson) {
         resolve_transfer_function("slicer:" + kData + "slicer-presets.xml#Lacuna-MR-Brain");
     EXPECT_FALSE(mr.range);
     EXPECT_EQ(discretise(mr, {0.f, 255.f}).vis.max, 255.f);
+    // shade="0": no shading; its gradient opacity (0.5 at 0, 1 from 20 on) is kept.
+    EXPECT_FALSE(mr.rendering.shading);
+    EXPECT_EQ(mr.rendering.gradient_opacity,
+              (std::vector<OpacityPoint>{{0, 0.5f}, {20, 1.f}, {255, 1.f}}));
+    // .vp.json's disableGradientOpacity drops it.
+    SlicerVolumeProperty off = resolve_slicer_preset("slicer:" + kData + "slicer-presets.xml#Lacuna-MR-Brain");
+    off.gradient_opacity_enabled = false;
+    EXPECT_TRUE(to_transfer_function(off).rendering.gradient_opacity.empty());
 }
 
 TEST(SlicerPresets, MalformedEntriesNameFileEntryAndField) {

@@ -24,6 +24,38 @@ TEST(TransferJson, RoundTripsEveryPreset) {
     }
 }
 
+TEST(TransferJson, RoundTripsTheRenderingKeys) {
+    TransferFunction tf;
+    tf.name = "shaded";
+    tf.domain = TfDomain::Value;
+    tf.color = {{-1024, 0, 0, 0}, {3071, 1, 1, 1}};
+    tf.opacity = {{-1024, 0}, {200, 0}, {3071, 0.8f}};
+    tf.rendering.shading = TfShading{0.1f, 0.9f, 0.2f, 10.f};
+    tf.rendering.gradient_opacity = {{0, 0.f}, {12.5, 0.f}, {12.5, 0.25f}, {300, 1.f}};
+    tf.rendering.blend = BlendMode::MinIp;
+    const std::string text = to_json(tf);
+    EXPECT_EQ(parse_transfer_function(text, "t.json"), tf) << text;
+    EXPECT_NE(text.find(R"("shading": {"ambient": 0.1, "diffuse": 0.9, "specular": 0.2, "specular_power": 10})"),
+              std::string::npos) << text;
+    EXPECT_NE(text.find(R"("blend": "minip")"), std::string::npos) << text;
+    // Each part alone, and none: a TF without them writes none of the keys.
+    for (int part = 0; part < 4; ++part) {
+        TransferFunction t = tf;
+        if (part != 0) t.rendering.shading.reset();
+        if (part != 1) t.rendering.gradient_opacity.clear();
+        if (part != 2) t.rendering.blend.reset();
+        const std::string s = to_json(t);
+        EXPECT_EQ(parse_transfer_function(s, "t.json"), t) << s;
+        EXPECT_EQ(s.find("shading") != std::string::npos, part == 0) << s;
+        EXPECT_EQ(s.find("gradient_opacity") != std::string::npos, part == 1) << s;
+        EXPECT_EQ(s.find("blend") != std::string::npos, part == 2) << s;
+    }
+    // The parts count for equality.
+    TransferFunction other = tf;
+    other.rendering.shading->specular_power = 11.f;
+    EXPECT_FALSE(other == tf);
+}
+
 TEST(TransferJson, RoundTripsAwkwardFloatsAndValueDomain) {
     TransferFunction tf;
     tf.name = "awkward \"quoted\" name\twith tab";
@@ -169,6 +201,25 @@ TEST(TransferJson, RejectsEveryMalformedDocumentWithOneLineError) {
         {doc(R"("name": 7, )" + c + ", " + o), "name"},
         {doc(R"("description": [], )" + c + ", " + o), "description"},
         {doc(R"("opactiy": [], )" + c + ", " + o), "\"opactiy\""},
+        // The rendering keys (shading, gradient_opacity, blend).
+        {doc(c + ", " + o + R"(, "shading": true)"), "shading"},
+        {doc(c + ", " + o + R"(, "shading": {"ambient": 0.1, "diffuse": 1, "specular": 0})"),
+         "shading.specular_power"},
+        {doc(c + ", " + o + R"(, "shading": {"ambient": "a", "diffuse": 1, "specular": 0, "specular_power": 1})"),
+         "shading.ambient"},
+        {doc(c + ", " + o + R"(, "shading": {"ambient": 0, "diffuse": 1, "specular": 0, "specular_power": 1, "shine": 2})"),
+         "shading.shine"},
+        {doc(c + ", " + o + R"(, "shading": {"ambient": 1.5, "diffuse": 1, "specular": 0, "specular_power": 1})"),
+         "shading"},
+        {doc(c + ", " + o + R"(, "shading": {"ambient": 0, "diffuse": 1, "specular": 0, "specular_power": -1})"),
+         "shading"},
+        {doc(c + ", " + o + R"(, "gradient_opacity": [])"), "gradient_opacity"},
+        {doc(c + ", " + o + R"(, "gradient_opacity": {"x": 0})"), "gradient_opacity"},
+        {doc(c + ", " + o + R"(, "gradient_opacity": [[0, 1.5]])"), "gradient_opacity[0]"},
+        {doc(c + ", " + o + R"(, "gradient_opacity": [[-1, 1]])"), "gradient_opacity[0]"},
+        {doc(c + ", " + o + R"(, "gradient_opacity": [[5, 0], [1, 1]])"), "gradient_opacity[1]"},
+        {doc(c + ", " + o + R"(, "blend": "maximum")"), "blend"},
+        {doc(c + ", " + o + R"(, "blend": 1)"), "blend"},
     };
     for (const auto& kase : cases) {
         const std::string& text = kase.first;
