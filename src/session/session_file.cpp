@@ -549,7 +549,7 @@ SessionFile parse_session_file(const std::string& text, const std::string& where
     json j;
     try {
         j = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // parse_error, and out_of_range for a number past double
         throw Error(where, "json", std::string("not valid JSON: ") + e.what());
     }
     const Reader r(j, "", where);

@@ -158,10 +158,12 @@ TfShading read_shading(const json& j, const std::string& where) {
     const std::string shape =
         "an object {\"ambient\", \"diffuse\", \"specular\", \"specular_power\"} of numbers";
     if (!j.is_object()) throw Error(where, "shading", "expected " + shape + ", got " + brief(j));
-    for (const auto& [key, value] : j.items())
+    for (const auto& item : j.items()) {
+        const std::string& key = item.key();  // (a named reference: clang's C++20 captures no bindings)
         if (std::find_if(kShadingKeys.begin(), kShadingKeys.end(),
                          [&](const char* k) { return key == k; }) == kShadingKeys.end())
             throw Error(where, "shading." + key, "unknown key; expected " + shape);
+    }
     float v[4];
     for (size_t i = 0; i < 4; ++i) {
         const std::string field = std::string("shading.") + kShadingKeys[i];

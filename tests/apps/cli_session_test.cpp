@@ -192,6 +192,18 @@ TEST(CliSession, MalformedFilesNameTheFieldAndWriteNothing) {
 }
 
 // The parser on its own: every field read back as written (floats exactly).
+// fuzz_session_file's finding: a number past double (8888E8888) made nlohmann throw out_of_range,
+// which the reader did not catch (the process aborted); now one error naming "json".
+TEST(SessionFile, NumberPastDoubleIsAnErrorNotAnAbort) {
+    std::string msg;
+    try {
+        lacuna::parse_session_file(R"({"lacuna_session": 1, "qva": [8888E8888]})", "x.json");
+    } catch (const lacuna::Error& e) {
+        msg = e.what();
+    }
+    EXPECT_NE(msg.find("x.json: json: not valid JSON"), std::string::npos) << msg;
+}
+
 TEST(SessionFile, RoundTripIsExact) {
     lacuna::SessionFile s;
     s.volume.path = "/data/head.nii.gz";
