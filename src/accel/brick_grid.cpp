@@ -158,6 +158,51 @@ std::vector<int> chebyshev_distances(const int n[3], Occupied&& occupied) {
 }
 }  // namespace
 
+// The leap map's eight octant maps (see leap_map): octant o (bit a set: the ray's dir_a < 0)
+// gives brick b the largest d such that every brick of the box reaching d - 1 bricks from b
+// toward the octant, prod_a (bit a ? [b_a - d + 1, b_a] : [b_a, b_a + d - 1]), is empty
+// (bricks past the grid are empty; capped at kCap). The largest-empty-cube recurrence: the box
+// of side d at b is b itself and the seven boxes of side d - 1 at b + s delta, delta in
+// {0, 1}^3 minus 0, s the octant's step per axis (any brick p of the box other than b lies in
+// the one with delta_a = [p_a != b_a]), so
+//     S(b) = occupied(b) ? 0 : min(kCap, 1 + min_delta S(b + s delta)),
+// swept against s, in a copy of the grid flipped to s = +1 with one plane of kCap past its
+// far faces. `near` holds octant 0's layout: low byte 0 where occupied, high byte the
+// sub-bricks (copied into every octant). One octant per task.
+static void octant_distances(const int nf[3], const uint16_t* near, int threads, uint16_t* leap) {
+    const int nx = nf[0], ny = nf[1], nz = nf[2];
+    const size_t n = size_t(nx) * size_t(ny) * size_t(nz);
+    const size_t px = size_t(nx) + 1, pxy = px * (size_t(ny) + 1);
+    parallel_for(8, threads, [&](size_t o0, size_t o1) {
+        std::vector<uint8_t> s(pxy * (size_t(nz) + 1), uint8_t(kCap));
+        for (size_t o = o0; o < o1; ++o) {
+            const bool neg[3] = {bool(o & 1), bool(o & 2), bool(o & 4)};
+            for (int z = nz - 1; z >= 0; --z)
+                for (int y = ny - 1; y >= 0; --y) {
+                    // (x, y, z) in the flipped copy is brick (fx, fy, fz) of the grid
+                    const int fy = neg[1] ? ny - 1 - y : y, fz = neg[2] ? nz - 1 - z : z;
+                    const size_t row = (size_t(fz) * size_t(ny) + size_t(fy)) * size_t(nx);
+                    uint8_t* c = s.data() + size_t(z) * pxy + size_t(y) * px;
+                    const uint8_t* cy = c + px;
+                    const uint8_t* cz = c + pxy;
+                    const uint8_t* cyz = cz + px;
+                    uint16_t* out = leap + o * n + row;
+                    for (int x = nx - 1; x >= 0; --x) {
+                        const int fx = neg[0] ? nx - 1 - x : x;
+                        const uint16_t e = near[row + size_t(fx)];
+                        int d = 0;
+                        if (e & 0xff) {
+                            int m = std::min({c[x + 1], cy[x], cy[x + 1], cz[x], cz[x + 1], cyz[x], cyz[x + 1]});
+                            d = std::min(kCap, m + 1);
+                        }
+                        c[x] = uint8_t(d);
+                        out[fx] = uint16_t((e & 0xff00) | unsigned(d));
+                    }
+                }
+        }
+    });
+}
+
 // The block grid's distances (the DDA's leaps out of empty blocks), at least 1.
 void BrickGrid::compute_distances() {
     const std::vector<int> f = chebyshev_distances(m_nw, [&](size_t i) { return m_words[i] != 0; });
@@ -247,13 +292,15 @@ void BrickGrid::refine() {
         for (int a = 0; a < 3; ++a) m_nf[a] = (m_pyr.cells[a] + (1 << kLeapLog2) - 1) >> kLeapLog2;
     }
     const uint16_t* next = m_next_visible.data();
-    const std::vector<int> f = chebyshev_distances(
-        m_nf, [&](size_t i) { return next[m_fine_lo[i]] <= m_fine_hi[i]; });
-    m_leap.assign(f.size() + 1, 0);  // padding: kernels read 32-bit words
-    for (size_t i = 0; i < f.size(); ++i) m_leap[i] = uint16_t(f[i]);
+    const size_t n = size_t(m_nf[0]) * size_t(m_nf[1]) * size_t(m_nf[2]);
+    // Octant 0's layout first: occupancy (0 occupied, 1 empty) and the sub-bricks' high bytes.
+    std::vector<uint16_t> near(n + 1, 0);
+    for (size_t i = 0; i < n; ++i) near[i] = next[m_fine_lo[i]] <= m_fine_hi[i] ? 0 : 1;
     const uint16_t* next_invisible = m_next_invisible.data();
     leap_sub_bricks(m_volume, m_mask.data(), m_nf, m_opts.threads,
-                    [&](size_t i) { return next_invisible[m_fine_lo[i]] > m_fine_hi[i]; }, m_leap);
+                    [&](size_t i) { return next_invisible[m_fine_lo[i]] > m_fine_hi[i]; }, near);
+    m_leap.assign(8 * n + 1, 0);  // padding: kernels read 32-bit words
+    octant_distances(m_nf, near.data(), m_opts.threads, m_leap.data());
     m_stats.refine_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

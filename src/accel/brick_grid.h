@@ -55,14 +55,18 @@ public:
     // The mask once refine() has run for the current TF, else nullptr (the kernels then take
     // every sample of a run).
     const uint32_t* cell_mask() const { return m_mask_ready ? m_mask.data() : nullptr; }
-    // Also made by refine(): the leap map, one 16-bit entry per fine brick of 4^3 cells
-    // (kLeapLog2), x fastest over leap_dims(), one entry of padding (the lane kernels read 32-bit
-    // words); nullptr until refine() ran for the current TF.
+    // Also made by refine(): the leap map, eight maps of one 16-bit entry per fine brick of 4^3
+    // cells (kLeapLog2), octant-major (entry o * leap_octant_stride() + brick), x fastest over
+    // leap_dims(), one entry of padding (the lane kernels read 32-bit words); nullptr until
+    // refine() ran for the current TF. Octant o is the rays whose dir_a < 0 exactly for the axes
+    // a of o's set bits (bit 0 x, 1 y, 2 z).
     //   low byte d: 0 if the brick's range with the bricks' one-cell apron may read a visible
-    //     entry, else the Chebyshev distance (in fine bricks, capped at 255) to the nearest such
-    //     brick. A ray at a point of brick b with d >= 1 may skip every sample before it leaves
-    //     the box of bricks within distance d - 1 of b: all are empty, and float error is
-    //     absorbed by the apron (core/simd_lanes.h, "Leaping").
+    //     entry (in every octant), else the largest d (capped at 255) for which every brick of
+    //     the box reaching d - 1 bricks from b toward the octant, per axis [b_a, b_a + d - 1],
+    //     or [b_a - d + 1, b_a] where o's bit a is set, is empty (bricks past the grid are
+    //     empty). A ray of that octant at a point of brick b with d >= 1 may skip every sample
+    //     before it leaves that box: it cannot reach the bricks behind it, all ahead are empty,
+    //     and float error is absorbed by the apron (core/simd_lanes.h, "Leaping").
     //   high byte, where d = 0: bit sx + 2 sy + 4 sz set iff the sub-brick of 2^3 cells at
     //     (sx, sy, sz) in b, with its own one-cell apron (cells 4b + 2s - 1 .. 4b + 2s + 2 per
     //     axis), holds a cell of the visible-cell mask (bits of sub-bricks past the grid, which
@@ -71,6 +75,7 @@ public:
     static constexpr int kLeapLog2 = 2;
     const uint16_t* leap_map() const { return m_mask_ready ? m_leap.data() : nullptr; }
     const int* leap_dims() const { return m_nf; }
+    size_t leap_octant_stride() const { return size_t(m_nf[0]) * size_t(m_nf[1]) * size_t(m_nf[2]); }
 
     int brick_log2() const { return m_log2; }
     const int* bricks() const { return m_nb; }

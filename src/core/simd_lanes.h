@@ -20,10 +20,15 @@
 //
 // Leaping (kLeap, the refined grid; the scheduler then hands each lane its whole ray as one run).
 // Each lane looks up the leap map at its sample's clamped position q (the fine brick b of q's
-// trilinear cell c, 4^3 cells): distance d = 0, the sample is composited as always; d >= 1, every
-// fine brick within Chebyshev distance d - 1 of b is empty (BrickGrid::leap_map), so the ray may
-// skip every sample before it leaves the box of those bricks, [4(b - d + 1), 4(b + d)) cells per
-// axis. Along axis a the ray leaves it through the face ahead of it,
+// trilinear cell c, 4^3 cells) in the map of its ray's octant (which of dir's components are
+// negative: one map per octant, BrickGrid::leap_map): distance d = 0, the sample is composited as
+// always; d >= 1, every fine brick of the box reaching d - 1 bricks from b toward the octant is
+// empty, [4 b_a, 4(b_a + d)) cells on an axis with dir_a >= 0, [4(b_a - d + 1), 4 b_a + 4) with
+// dir_a < 0, so the ray may skip every sample before it leaves that box. (A box behind the ray
+// is never entered: per axis the clamped position only moves toward the octant, so only the
+// bricks ahead need be empty, and a ray leaving an occupied region leaps at once across the
+// empty space in front of it, which a symmetric distance, held to 1 by the bricks just behind,
+// would not let it.) Along axis a the ray leaves the box through the face ahead of it,
 //     face_a = 4 b_a + (dir_a < 0 ? 4 - 4d : 4d),   T_a = (face_a - q_a) / dir_a,
 // and the lane skips s = floor(min_a T_a / dt) + 1 samples (T = min_a T_a >= 0, since
 // q_a lies in [4 b_a, 4 b_a + 4]): samples k .. k + s - 1 have (s - 1) dt <= T. The next sample
@@ -33,7 +38,9 @@
 //     face_a = (c_a & -2) + (dir_a < 0 ? 0 : 2).
 // Why this is exact. (1) Clamping only helps: where the clamped trajectory differs from the ray
 // it stays on the volume's boundary, which moves it no faster toward a face ahead than q + t dir
-// does. (2) Float error (T's rounding, the skipped samples' own positions, a few ulps of
+// does, and never backward (each coordinate, o_a + t dir_a rounded then clamped, is monotone in
+// k: every operation of it is monotone), so it stays in the octant's box until it crosses a face
+// ahead. (2) Float error (T's rounding, the skipped samples' own positions, a few ulps of
 // coordinates below 2^13) moves a skipped sample past the face by far less than one cell, and
 // the bricks' ranges include a one-cell apron, so its trilinear cell still reads only entries the
 // box's boundary bricks cover. 1 / dir is clamped to +-1e30 (a zero direction, +0 or -0, gives a
@@ -97,6 +104,7 @@ struct LaneGrid {
     // brick the distance d and, where d = 0, the sub-bricks' bits) and its strides in fine bricks.
     const uint16_t* leap = nullptr;
     int32_t leap_sy = 0, leap_sz = 0;
+    int32_t leap_octant = 0;  // entries per octant map (bricks of the grid)
 };
 
 // Eight camera rays at once, for the scheduler's ray set-up: Camera::generate, the move into
@@ -449,17 +457,25 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, co
     }
 }
 
-// Leaping's per-lane set-up: 1 / dir per axis, clamped to +-1e30 (see "Leaping" above).
+// Leaping's per-lane set-up: 1 / dir per axis, clamped to +-1e30, and the offset of the lane's
+// octant map, octant (sign bits of the three inverses) times the octant stride (see "Leaping").
 struct LeapInverse {
     alignas(64) float inv[3][kMaxLanes];
+    alignas(64) int32_t octant[kMaxLanes];
 };
 LACUNA_AVX2 inline __attribute__((always_inline)) void leap_inverse8(__m256 dx, __m256 dy, __m256 dz,
-                                                                  LeapInverse& li) {
+                                                                  int32_t stride, LeapInverse& li) {
     const __m256 big = _mm256_set1_ps(1e30f), one = _mm256_set1_ps(1.f);
     const __m256 d[3] = {dx, dy, dz};
-    for (int a = 0; a < 3; ++a)
-        _mm256_store_ps(li.inv[a], _mm256_max_ps(_mm256_sub_ps(_mm256_setzero_ps(), big),
-                                                  _mm256_min_ps(big, _mm256_div_ps(one, d[a]))));
+    __m256i oct = _mm256_setzero_si256();
+    for (int a = 0; a < 3; ++a) {
+        const __m256 inv = _mm256_max_ps(_mm256_sub_ps(_mm256_setzero_ps(), big),
+                                         _mm256_min_ps(big, _mm256_div_ps(one, d[a])));
+        _mm256_store_ps(li.inv[a], inv);
+        oct = _mm256_or_si256(oct, _mm256_slli_epi32(_mm256_srli_epi32(_mm256_castps_si256(inv), 31), a));
+    }
+    _mm256_store_si256(reinterpret_cast<__m256i*>(li.octant),
+                       _mm256_mullo_epi32(oct, _mm256_set1_epi32(stride)));
 }
 // The valid lanes' next sample: k + 1, or leaping k + adv (at most kend).
 template <bool kLeap>
@@ -489,7 +505,7 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, 
     const __m256i idx = _mm256_add_epi32(
         _mm256_add_epi32(_mm256_mullo_epi32(f[2], _mm256_set1_epi32(g.leap_sz)),
                          _mm256_mullo_epi32(f[1], _mm256_set1_epi32(g.leap_sy))),
-        f[0]);
+        _mm256_add_epi32(f[0], _mm256_load_si256(reinterpret_cast<const __m256i*>(li.octant))));
     const __m256i w = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
                                                   reinterpret_cast<const int*>(g.leap), idx, valid, 2);
     const __m256i d = _mm256_and_si256(w, _mm256_set1_epi32(0xff));
@@ -581,7 +597,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
     ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);     \
     aa = _mm256_load_ps(s.a);                                                         \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
-    if constexpr (kLeap) leap_inverse8(dx, dy, dz, linv);
+    if constexpr (kLeap) leap_inverse8(dx, dy, dz, g.leap_octant, linv);
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
     int active_mask, waiting = 0;
@@ -790,7 +806,7 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
     const __m512i idx = _mm512_add_epi32(
         _mm512_add_epi32(_mm512_mullo_epi32(_mm512_srli_epi32(c[2], 2), _mm512_set1_epi32(g.leap_sz)),
                          _mm512_mullo_epi32(_mm512_srli_epi32(c[1], 2), _mm512_set1_epi32(g.leap_sy))),
-        _mm512_srli_epi32(c[0], 2));
+        _mm512_add_epi32(_mm512_srli_epi32(c[0], 2), _mm512_load_si512(li.octant)));
     const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 2);
     const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
     const __m512i two = _mm512_set1_epi32(2);
@@ -821,11 +837,16 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
 }
 // leap_inverse8's clamped 1 / dir, sixteen lanes.
 LACUNA_AVX512 inline __attribute__((always_inline)) void leap_inverse16(__m512 dx, __m512 dy, __m512 dz,
-                                                                   LeapInverse& li) {
+                                                                   int32_t stride, LeapInverse& li) {
     const __m512 big = _mm512_set1_ps(1e30f), nbig = _mm512_set1_ps(-1e30f), one = _mm512_set1_ps(1.f);
     const __m512 d[3] = {dx, dy, dz};
-    for (int a = 0; a < 3; ++a)
-        _mm512_store_ps(li.inv[a], _mm512_max_ps(nbig, _mm512_min_ps(big, _mm512_div_ps(one, d[a]))));
+    __m512i oct = _mm512_setzero_si512();
+    for (int a = 0; a < 3; ++a) {
+        const __m512 inv = _mm512_max_ps(nbig, _mm512_min_ps(big, _mm512_div_ps(one, d[a])));
+        _mm512_store_ps(li.inv[a], inv);
+        oct = _mm512_or_si512(oct, _mm512_slli_epi32(_mm512_srli_epi32(_mm512_castps_si512(inv), 31), unsigned(a)));
+    }
+    _mm512_store_si512(li.octant, _mm512_mullo_epi32(oct, _mm512_set1_epi32(stride)));
 }
 
 // prefetch_ahead8 for sixteen lanes.
@@ -879,7 +900,7 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     n = _mm512_load_si512(s.n);                                                             \
     ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b);           \
     aa = _mm512_load_ps(s.a);                                                               \
-    if constexpr (kLeap) leap_inverse16(dx, dy, dz, linv);
+    if constexpr (kLeap) leap_inverse16(dx, dy, dz, g.leap_octant, linv);
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m512 inv_dt = _mm512_set1_ps(1.f / g.dt);
     int waiting = 0;

@@ -709,7 +709,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
     n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
     aa = _mm256_load_ps(s.a);                                                         \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
-    if constexpr (kLeap) leap_inverse8(dx, dy, dz, linv);
+    if constexpr (kLeap) leap_inverse8(dx, dy, dz, g.leap_octant, linv);
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
     int active_mask, waiting = 0;
@@ -803,7 +803,7 @@ LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* da
     n = _mm512_load_si512(s.n);                                                             \
     aa = _mm512_load_ps(s.a);                                                               \
     vrec = _mm512_loadu_si512(rec); /* the lanes' records (a refill may change them) */     \
-    leap_inverse16(dx, dy, dz, linv);
+    leap_inverse16(dx, dy, dz, g.leap_octant, linv);
     LeapInverse linv;
     const __m512 inv_dt = _mm512_set1_ps(1.f / g.dt);
     int waiting = 0;

@@ -59,6 +59,7 @@ inline void set_leap(simd::LaneGrid& lg, const BrickGrid& grid) {
     lg.leap = grid.leap_map();
     lg.leap_sy = n[0];
     lg.leap_sz = n[0] * n[1];
+    lg.leap_octant = int32_t(grid.leap_octant_stride());
 }
 
 // Runs `march(lanes, refill)` over the tile's rays; dt, chunk and ert as the kernel's.

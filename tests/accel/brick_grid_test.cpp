@@ -137,13 +137,15 @@ TEST(BrickGrid, RefinedCellMaskIsTheVisibilityOfEveryCellsRange) {
 }
 
 // The leap map against brute force from the built cell ranges: a fine brick (4^3 cells) is at
-// distance 0 iff some cell of it or of its one-cell apron has a visible range, else its
-// Chebyshev distance to the nearest such brick (capped at 255); a brick at distance 0 sets bit
+// distance 0 iff some cell of it or of its one-cell apron has a visible range, else, in the map
+// of each octant, the side of the largest box of bricks from it toward the octant holding no
+// such brick (capped at 255; the least over the octants is the Chebyshev distance to the
+// nearest one); a brick at distance 0 sets bit
 // sx + 2 sy + 4 sz iff some cell of sub-brick (sx, sy, sz) (2^3 cells) or of its apron does
 // (sub-bricks past the grid are free).
 TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
     Rng rng{9109};
-    int near = 0, far = 0, sub_set = 0, sub_clear = 0;
+    int near = 0, far = 0, sub_set = 0, sub_clear = 0, longer = 0;
     for (int trial = 0; trial < 40; ++trial) {
         const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 40), rng);
         AccelOptions o;
@@ -183,17 +185,35 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
                     const int lo[3] = {4 * x - 1, 4 * y - 1, 4 * z - 1}, hi[3] = {4 * x + 4, 4 * y + 4, 4 * z + 4};
                     occ[(size_t(z) * nf[1] + y) * nf[0] + x] = any_visible(lo, hi);
                 }
+        const size_t stride = g.leap_octant_stride();
+        ASSERT_EQ(stride, occ.size());
         for (int z = 0; z < nf[2]; ++z)
             for (int y = 0; y < nf[1]; ++y)
                 for (int x = 0; x < nf[0]; ++x) {
-                    int dist = 255;
-                    for (int c = 0; c < nf[2]; ++c)
-                        for (int b = 0; b < nf[1]; ++b)
-                            for (int a = 0; a < nf[0]; ++a)
-                                if (occ[(size_t(c) * nf[1] + b) * nf[0] + a])
-                                    dist = std::min(dist, std::max({std::abs(a - x), std::abs(b - y), std::abs(c - z)}));
-                    const uint16_t e = leap[(size_t(z) * nf[1] + y) * nf[0] + x];
-                    ASSERT_EQ(e & 0xff, dist) << describe(v, lut) << " fine brick " << x << "," << y << "," << z;
+                    const size_t id = (size_t(z) * nf[1] + y) * nf[0] + x;
+                    // Per octant: the side of the largest box from (x, y, z) toward it with no
+                    // occupied brick, i.e. the least max_a s_a (p_a - b_a) over the occupied p
+                    // ahead (s_a (p_a - b_a) >= 0 on every axis), capped at 255.
+                    int dist = 255, wants[8];
+                    for (int o = 0; o < 8; ++o) {
+                        const int sx = o & 1 ? -1 : 1, sy = o & 2 ? -1 : 1, sz = o & 4 ? -1 : 1;
+                        int want = 255;
+                        for (int c = 0; c < nf[2]; ++c)
+                            for (int b = 0; b < nf[1]; ++b)
+                                for (int a = 0; a < nf[0]; ++a) {
+                                    const int u = sx * (a - x), w = sy * (b - y), t = sz * (c - z);
+                                    if (u < 0 || w < 0 || t < 0 || !occ[(size_t(c) * nf[1] + b) * nf[0] + a]) continue;
+                                    want = std::min(want, std::max({u, w, t}));
+                                }
+                        const uint16_t eo = leap[o * stride + id];
+                        ASSERT_EQ(eo & 0xff, want) << describe(v, lut) << " fine brick " << x << "," << y
+                                                   << "," << z << " octant " << o;
+                        ASSERT_EQ(eo >> 8, leap[id] >> 8) << "the sub-bricks are the same in every octant";
+                        wants[o] = want;
+                        dist = std::min(dist, want);  // (the symmetric Chebyshev distance)
+                    }
+                    for (int o = 0; o < 8; ++o) longer += wants[o] > dist;
+                    const uint16_t e = leap[id];
                     if (dist > 0) {
                         ASSERT_EQ(e >> 8, 0) << "sub-bricks of a far brick";
                         ++far;
@@ -216,6 +236,7 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
     EXPECT_GT(far, 200);
     EXPECT_GT(sub_set, 500);
     EXPECT_GT(sub_clear, 200);
+    EXPECT_GT(longer, 200) << "octant maps that see farther than the symmetric distance";
 }
 
 // Zero everywhere but a few random voxels: empty blocks to leap over.
