@@ -7,7 +7,9 @@
 
 #include "bench/report.h"
 #include "lacuna/error.h"
+#include "lacuna/frame_spec.h"
 #include "lacuna/renderer.h"
+#include "lacuna/session.h"
 #include "render/sample_analysis.h"
 
 namespace lacuna::bench {
@@ -22,42 +24,61 @@ RenderOptions render_options(const FaludiOptions& o, RowMode m, const Box3f& bou
     return row_render_options(o, m, bounds);
 }
 
-// Builds a structure and times its TF changes.
+// A row's orbit through `k` as the session renders it: the row's render options (sampling,
+// shading, the spotlight and its shadows) as a FrameSpec, one per view.
+std::vector<FrameSpec> row_frames(const FaludiOptions& o, RowMode m, const Session& session,
+                                  AccelKind k) {
+    const RenderOptions ro = render_options(o, m, session.bounds());
+    FrameSpec base;
+    base.renderer = Renderer::RayMarcher;
+    base.structure = structure_of(k, o.accel);
+    base.sampling.step = ro.step;
+    base.sampling.interpolation = ro.interpolation;
+    base.sampling.early_termination =
+        ro.ert < 1.f ? std::optional<float>(ro.ert) : std::optional<float>{};
+    base.features = ro.features;
+    return orbit_frames(base, o.orbit);
+}
+
+// Builds a structure through the session (its first frame's prepare) and times its TF
+// changes. Every structure in lacuna recomputes its whole TF-dependent part on each change
+// (none caches the previous LUT); the session syncs a structure lazily, so a repeat sets the
+// same TF under another name and then the dataset's own again, and times the one sync that
+// brings the structure back to it.
 StructureResult build_structure(AccelKind k, const BenchDataset& d, const FaludiOptions& o,
-                                std::unique_ptr<Accel>& accel) {
+                                Session& session, const FrameSpec& frame) {
     StructureResult s;
     s.kind = k;
-    AccelOptions ao = o.accel;
-    ao.threads = o.threads;
-    ao.interpolation = o.interpolation;
-    const auto t0 = std::chrono::steady_clock::now();
-    accel = make_accel(k, *d.volume, ao);
-    accel->set_transfer_function(d.lut);
-    s.generation_ms = ms_since(t0);
-    s.build_ms = accel->stats().build_seconds * 1e3;
-    // Every structure in lacuna recomputes its whole TF-dependent part on each change (none
-    // caches the previous LUT), so setting the same LUT again costs a real change.
+    const FrameResult built = session.prepare(frame);
+    s.generation_ms = (built.build_seconds + built.tf_sync_seconds) * 1e3;
+    s.build_ms = built.structure ? built.structure->build_seconds * 1e3 : 0;
     std::vector<double> tf;
-    tf.push_back(accel->stats().tf_update_seconds * 1e3);
+    if (built.structure) tf.push_back(built.structure->tf_update_seconds * 1e3);
+    TransferFunction other = d.tf;  // the same LUT under another name: a change to the session
+    other.name += " (again)";
     for (int r = 1; r < std::max(1, o.tf_repeats); ++r) {
-        accel->set_transfer_function(d.lut);
-        tf.push_back(accel->stats().tf_update_seconds * 1e3);
+        session.set_transfer_function(other);
+        session.set_transfer_function(d.tf);
+        const FrameResult again = session.prepare(frame);
+        if (again.structure) tf.push_back(again.structure->tf_update_seconds * 1e3);
     }
-    s.tf_change_ms = percentile(tf, 50);
+    s.tf_change_ms = tf.empty() ? 0 : percentile(tf, 50);
     if (o.refine) {
-        accel->refine();
-        s.refine_ms = accel->stats().refine_seconds * 1e3;
+        session.refine();
+        if (const Accel* a = session.built_structure(frame)) s.refine_ms = a->stats().refine_seconds * 1e3;
     }
-    s.bytes = accel->stats().bytes;
-    s.nodes = accel->stats().nodes;
+    if (const Accel* a = session.built_structure(frame)) {
+        s.bytes = a->stats().bytes;
+        s.nodes = a->stats().nodes;
+    }
     return s;
 }
 
 // One cell of the table; compares view 0 with `reference` (none's), or hands view 0 back in
 // `first` (for none itself).
-CellResult run_cell(AccelKind k, const RayMarcher& m, const std::vector<Camera>& cams,
-                    const RenderOptions& ro, const Image* reference, Image* first = nullptr) {
-    OrbitRun run = run_orbit(m, cams, ro);
+CellResult run_cell(AccelKind k, Session& session, const std::vector<FrameSpec>& frames,
+                    const Image* reference, Image* first = nullptr) {
+    OrbitRun run = run_orbit(session, frames);
     if (first) *first = std::move(run.first_image);
     CellResult c;
     c.kind = k;
@@ -92,9 +113,14 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
     out.type = d.volume->type();
     out.spacing = d.volume->spacing;
 
-    RayMarcher m(*d.volume);
-    m.set_transfer_function(d.lut);
-    const std::vector<Camera> cams = orbit_cameras(m.bounds(), o.orbit);
+    // Every cell renders through one session (as every front end does): each structure is built
+    // by its first frame's prepare() and dropped after its rows.
+    Session session(*d.volume, o.threads);  // shares the voxels
+    session.set_transfer_function(d.tf);
+    const Box3f bounds = session.bounds();
+    std::vector<Camera> cams;
+    for (const FrameSpec& f : row_frames(o, o.modes[0], session, AccelKind::None))
+        cams.push_back(session.camera(f));
     const std::vector<AccelKind> kinds = bench_columns(o.accels);
 
     // 1. The reference rows (none) and their view-0 images.
@@ -102,15 +128,15 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
     for (RowMode mode : o.modes) {
         RowResult row;
         row.mode = mode;
-        row.ert = render_options(o, mode, m.bounds()).ert;
+        row.ert = render_options(o, mode, bounds).ert;
         out.rows.push_back(row);
     }
     out.structures.push_back(StructureResult{});
     for (RowResult& row : out.rows) {
         if (log) log("  " + d.name + " " + to_string(row.mode) + " none ...");
         reference.push_back(Image{});
-        CellResult c = run_cell(AccelKind::None, m, cams, render_options(o, row.mode, m.bounds()), nullptr,
-                                &reference.back());
+        CellResult c = run_cell(AccelKind::None, session, row_frames(o, row.mode, session, AccelKind::None),
+                                nullptr, &reference.back());
         c.exact = true;
         c.speedup = c.sample_reduction = 1;
         row.cells.push_back(c);
@@ -124,7 +150,7 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
         if (o.ideal) {
             for (RowResult& row : out.rows) {
                 const auto t1 = std::chrono::steady_clock::now();
-                const RenderOptions ro = render_options(o, row.mode, m.bounds());
+                const RenderOptions ro = render_options(o, row.mode, bounds);
                 // Shading and lighting change what a sample costs, not which samples a ray
                 // takes: their ideal is that of the early-exit row.
                 const RowResult* same = nullptr;
@@ -157,8 +183,8 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
     // 3. Every structure: build, time TF changes, render each row, compare view 0.
     for (AccelKind k : kinds) {
         if (k == AccelKind::None) continue;
-        std::unique_ptr<Accel> accel;
-        const StructureResult s = build_structure(k, d, o, accel);
+        const StructureResult s =
+            build_structure(k, d, o, session, row_frames(o, o.modes[0], session, k)[0]);
         out.structures.push_back(s);
         if (log) {
             char line[256];
@@ -170,10 +196,9 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
                 double(s.bytes) / (1 << 20), s.nodes);
             log(line);
         }
-        m.set_accel(accel.get());
         for (size_t r = 0; r < out.rows.size(); ++r) {
             RowResult& row = out.rows[r];
-            CellResult c = run_cell(k, m, cams, render_options(o, row.mode, m.bounds()), &reference[r]);
+            CellResult c = run_cell(k, session, row_frames(o, row.mode, session, k), &reference[r]);
             const CellResult& none = row.cells[0];
             c.speedup = c.frame_ms.mean > 0 ? none.frame_ms.mean / c.frame_ms.mean : 0;
             c.sample_reduction = c.samples ? double(none.samples) / double(c.samples) : 0;
@@ -183,7 +208,7 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
                 log("  !!! " + d.name + " " + to_string(row.mode) + " " + to_string(k) +
                     ": view 0 differs from none: an exactness bug");
         }
-        m.set_accel(nullptr);
+        session.drop_structures();
     }
     return out;
 }

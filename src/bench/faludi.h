@@ -3,7 +3,8 @@
 // skipping structure; per cell the mean and p99 frame time over an orbit, samples per ray, the
 // speedup over `none` measured in the same run, and whether view 0 is byte-identical to none's.
 // Per row also the ideal speedup (src/render/sample_analysis.h); per structure generation time,
-// memory and TF-change time.
+// memory and TF-change time. Every cell renders through a Session (lacuna/session.h), as every
+// front end does: FrameSpecs per row and structure, the session builds and syncs the structures.
 #pragma once
 #include <cstdint>
 #include <functional>

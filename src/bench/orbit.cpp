@@ -34,15 +34,6 @@ std::vector<FrameSpec> orbit_frames(const FrameSpec& base, const OrbitSpec& spec
     return out;
 }
 
-std::vector<Camera> orbit_cameras(const Box3f& bounds, const OrbitSpec& spec) {
-    check(spec);
-    std::vector<Camera> out;
-    out.reserve(size_t(spec.views));
-    for (int i = 0; i < spec.views; ++i)
-        out.push_back(Camera::orbit(bounds, view(OrbitParams{}, spec, i), spec.size, spec.size));
-    return out;
-}
-
 namespace {
 
 void add(OrbitRun& run, size_t v, RenderStats stats, Image&& image) {
@@ -59,17 +50,6 @@ OrbitRun run_orbit(Session& session, const std::vector<FrameSpec>& frames) {
     run.frame_seconds.reserve(frames.size());
     for (size_t v = 0; v < frames.size(); ++v) {
         FrameResult r = session.render(frames[v]);
-        add(run, v, r.stats, std::move(r.image));
-    }
-    return run;
-}
-
-OrbitRun run_orbit(const RayMarcher& marcher, const std::vector<Camera>& cameras,
-                   const RenderOptions& options) {
-    OrbitRun run;
-    run.frame_seconds.reserve(cameras.size());
-    for (size_t v = 0; v < cameras.size(); ++v) {
-        RenderResult r = marcher.render(cameras[v], options);
         add(run, v, r.stats, std::move(r.image));
     }
     return run;

@@ -25,9 +25,6 @@ struct OrbitSpec {
 // framing of the session's bounds, perspective, view 0 at azimuth 0.
 std::vector<FrameSpec> orbit_frames(const FrameSpec& base, const OrbitSpec& spec);
 
-// The same views as cameras framing `bounds` (for renderers driven by hand: bench faludi).
-std::vector<Camera> orbit_cameras(const Box3f& bounds, const OrbitSpec& spec);
-
 struct OrbitRun {
     std::vector<double> frame_seconds;  // per view, RenderStats::seconds
     uint64_t samples = 0, rays = 0;     // summed over the views
@@ -38,9 +35,5 @@ struct OrbitRun {
 // Renders every frame through `session` (the first one builds what the frames need, outside
 // the frame times: call session.prepare(frames[0]) first to time that on its own).
 OrbitRun run_orbit(Session& session, const std::vector<FrameSpec>& frames);
-
-// Renders every camera with `marcher` as it is set up (TF, structure).
-OrbitRun run_orbit(const RayMarcher& marcher, const std::vector<Camera>& cameras,
-                   const RenderOptions& options);
 
 }  // namespace lacuna::bench
