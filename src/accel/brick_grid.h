@@ -156,20 +156,20 @@ public:
     // min_skip: empty stretches not longer than this stay in the run (world units). chunk: an
     // occupied stretch is handed out once this long (0 = never), so early ray termination does
     // not pay for walking to the far side.
-    Cursor(const BrickGrid& g, const CursorRay& r, float t_near, float t_far, float min_skip = 0.f,
+    Cursor(const BrickGrid& g, const IndexRay& r, float t_near, float t_far, float min_skip = 0.f,
            float chunk = 0.f)
         : m_g(g), m_t(t_near), m_far(t_far), m_min_skip(min_skip),
           m_chunk(chunk > 0.f ? chunk : INFINITY) {
         const int L = g.m_log2;
         for (int a = 0; a < 3; ++a) {
-            m_o[a] = r.o[a];
-            m_d[a] = r.d[a];
-            m_inv[a] = r.d[a] == 0.f ? 0.f : 1.f / r.d[a];
+            m_o[a] = r.o(a);
+            m_d[a] = r.d(a);
+            m_inv[a] = r.d(a) == 0.f ? 0.f : 1.f / r.d(a);
             m_cells[a] = g.m_pyr.cells[a];
             m_nbm1[a] = g.m_nb[a] - 1;
             // Branch-free brick crossings: the exit plane of brick n is (n + m_up) << L, and it
             // is the border (never crossed: +inf) when it is <= m_lo_lim or >= m_hi_lim.
-            const bool up = r.d[a] > 0.f, down = r.d[a] < 0.f;
+            const bool up = r.d(a) > 0.f, down = r.d(a) < 0.f;
             m_up[a] = up ? 1 : 0;
             m_step[a] = up ? 1 : -1;
             m_lo_lim[a] = up ? INT32_MIN : (down ? 0 : INT32_MAX);

@@ -23,11 +23,6 @@ struct Segment {
     float t0, t1;  // world ray parameters; samples outside all segments are provably invisible
 };
 
-// A ray in index space: position(t) = o + t*d, t in world units.
-struct CursorRay {
-    float o[3], d[3];
-};
-
 // Structure S provides: Region region(const int cell[3], int& hint) const;  and
 // const int* cells() const (cells per axis, dims - 1).
 template <class S>
@@ -42,7 +37,7 @@ public:
     // the next empty region or the ray's end). The marcher may stop early (early ray
     // termination), and walking the structure far beyond where it stops costs region queries
     // for nothing: through a head, every leaf up to the far side.
-    RegionCursor(const S& s, const CursorRay& r, float t_near, float t_far, float min_skip = 0.f,
+    RegionCursor(const S& s, const IndexRay& r, float t_near, float t_far, float min_skip = 0.f,
                  float chunk = 0.f)
         : m_s(s),
           m_r(r),
@@ -52,7 +47,7 @@ public:
           m_min_skip(min_skip),
           m_chunk(chunk > 0.f ? chunk : INFINITY) {
         float dmax = 0;
-        for (int a = 0; a < 3; ++a) dmax = std::max(dmax, std::abs(r.d[a]));
+        for (int a = 0; a < 3; ++a) dmax = std::max(dmax, std::abs(r.d(a)));
         m_margin_t = kMargin / dmax;
         m_nudge_t = 1e-3f / dmax;
         const int* n = s.cells();
@@ -60,7 +55,7 @@ public:
             m_hi[a] = float(n[a]);
             m_cells[a] = n[a];
             m_last[a] = n[a] - 1;
-            m_inv[a] = r.d[a] == 0.f ? 0.f : 1.f / r.d[a];
+            m_inv[a] = r.d(a) == 0.f ? 0.f : 1.f / r.d(a);
         }
     }
 
@@ -71,7 +66,7 @@ public:
             const float tq = m_t + m_nudge_t;
             int cell[3];
             for (int a = 0; a < 3; ++a) {
-                float p = m_r.o[a] + tq * m_r.d[a];
+                float p = m_r.o(a) + tq * m_r.d(a);
                 p = p < 0.f ? 0.f : (p > m_hi[a] ? m_hi[a] : p);
                 cell[a] = std::min(int(p), m_last[a]);
             }
@@ -81,14 +76,14 @@ public:
             // its parameter is -inf (entry) or +inf (exit).
             float ta = -INFINITY, tb = INFINITY;
             for (int a = 0; a < 3; ++a) {
-                if (m_r.d[a] == 0.f) continue;
-                const bool up = m_r.d[a] > 0.f;
+                if (m_r.d(a) == 0.f) continue;
+                const bool up = m_r.d(a) > 0.f;
                 const float t_lo = reg.box.lo[a] <= 0
                                        ? (up ? -INFINITY : INFINITY)
-                                       : (float(reg.box.lo[a]) - m_r.o[a]) * m_inv[a];
+                                       : (float(reg.box.lo[a]) - m_r.o(a)) * m_inv[a];
                 const float t_hi = reg.box.hi[a] >= m_cells[a]
                                        ? (up ? INFINITY : -INFINITY)
-                                       : (float(reg.box.hi[a]) - m_r.o[a]) * m_inv[a];
+                                       : (float(reg.box.hi[a]) - m_r.o(a)) * m_inv[a];
                 ta = std::max(ta, std::min(t_lo, t_hi));
                 tb = std::min(tb, std::max(t_lo, t_hi));
             }
@@ -124,7 +119,7 @@ public:
 
 private:
     const S& m_s;
-    CursorRay m_r;
+    IndexRay m_r;
     float m_t, m_far, m_seg_start;
     float m_min_skip, m_chunk;
     float m_margin_t, m_nudge_t;

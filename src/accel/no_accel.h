@@ -12,7 +12,7 @@ public:
 
     class Cursor {
     public:
-        Cursor(const NoAccel&, const CursorRay&, float t_near, float t_far, float = 0.f,
+        Cursor(const NoAccel&, const IndexRay&, float t_near, float t_far, float = 0.f,
                float = 0.f)
             : m_seg{t_near, t_far} {}
         bool next(Segment& out) {

@@ -163,7 +163,7 @@ float transmittance(const Context& c, const kernel::Grid<T, Index>& g, const S& 
         }
         return true;
     };
-    const CursorRay cr{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}};
+    const IndexRay& cr = r;
     const float chunk = c.ert < 1.f ? 16.f * c.dts : 0.f;
     if (c.f->shadows.accelerate) {
         typename S::Cursor cursor(accel, cr, 0.f, t1, c.dts, chunk);
@@ -719,7 +719,7 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                 const float j = f.jitter ? jitter(uint32_t(px), uint32_t(py), f.jitter_seed) : 0.5f;
                 const float t_base = t_near + (j - 0.5f) * c.dt;
                 const int k_end = lattice_end(t_base, t_far, c.dt);
-                const CursorRay cr = cursor_ray(r);
+                const IndexRay& cr = r;
                 if (f.blend == BlendMode::Mip || f.blend == BlendMode::MinIp) {
                     const bool maximum = f.blend == BlendMode::Mip;
                     int lo = 0, hi_e = c.map.last();

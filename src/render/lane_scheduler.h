@@ -148,7 +148,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                     run = 0 < k_end && ke > kb;
                 } else {
                     sl.runs.reset();
-                    sl.cursor.emplace(accel, cursor_ray(r), t_near, t_far, dt, chunk);
+                    sl.cursor.emplace(accel, r, t_near, t_far, dt, chunk);
                     sl.runs.emplace(*sl.cursor, t_base, dt, k_end);
                     run = sl.runs->next(kb, ke);
                 }

@@ -48,10 +48,6 @@ inline simd::CameraView camera_view(const Camera& c) {
                             c.projection() == Projection::Orthographic};
 }
 
-inline CursorRay cursor_ray(const kernel::IndexRay& r) {
-    return CursorRay{{r.ox, r.oy, r.oz}, {r.dx, r.dy, r.dz}};
-}
-
 // Number of lattice samples t_k = t_base + (k + 0.5)*dt with t_k < t_far.
 inline int lattice_end(float t_base, float t_far, float dt) {
     return std::max(int(std::ceil((t_far - t_base) / dt - 0.5f)), 0);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "accel/region.h"
 #include "lacuna/transfer_function.h"
 
 #if defined(__GNUC__)
@@ -90,10 +91,8 @@ struct Accum {
     float r = 0, g = 0, b = 0, a = 0;
 };
 
-// One ray in index space: point(t) = o + t*d, t in world units.
-struct IndexRay {
-    float ox, oy, oz, dx, dy, dz;
-};
+// The index-space ray (accel/region.h).
+using lacuna::IndexRay;
 
 // Slab test of a ray against the index-space box [0, hi]. Returns false on a miss. Every
 // consumer that must reproduce the reference's lattice (the marcher, the sample analysis) calls

@@ -101,7 +101,7 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
             float t_near, t_far;
             if (kernel::intersect_box(r, hi, t_near, t_far)) {
                 ++tile_rays;
-                typename S::Cursor cursor(accel, cursor_ray(r), t_near, t_far, dt,
+                typename S::Cursor cursor(accel, r, t_near, t_far, dt,
                                           opt.ert < 1.f ? kCursorChunk * dt : 0.f);
                 kernel::RayStream<T, Index, kNearest> stream(g, r, t_near, dt, lut.data(), map, opt.ert,
                                                    acc);

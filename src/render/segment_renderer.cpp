@@ -88,7 +88,7 @@ void render_tile(const S& accel, const Volume& geom, const T* data, const L* lab
             float t_near, t_far;
             if (kernel::intersect_box(r, hi, t_near, t_far)) {
                 ++tile_rays;
-                typename S::Cursor cursor(accel, cursor_ray(r), t_near, t_far, dt,
+                typename S::Cursor cursor(accel, r, t_near, t_far, dt,
                                           ert < 1.f ? kCursorChunk * dt : 0.f);
                 for_each_sample(cursor, t_near, dt, lattice_end(t_near, t_far, dt), [&](int s) {
                     // The ray marcher's lattice and clamping (ray_march_kernel.h).

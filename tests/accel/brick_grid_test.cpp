@@ -340,7 +340,7 @@ TEST(BrickGrid, WalkStepsTileTheRayAndHoldTheMarchersSamplePositions) {
                 if (!corner_ray(hi, B, rng, r, t_near, t_far)) continue;
                 const float dt = 0.02f + 0.5f * rng.uniform();
                 const int k_end = lattice_end(t_near, t_far, dt);
-                BrickGrid::Cursor cursor(g, cursor_ray(r), t_near, t_far);
+                BrickGrid::Cursor cursor(g, r, t_near, t_far);
                 BrickGrid::Cursor::Step st;
                 float t_prev = t_near;
                 int k = 0, steps = 0;
@@ -411,7 +411,7 @@ void check_skipped_samples(const BrickGrid& g, const Volume& v, const T* data,
         const float dt = 0.05f + 0.6f * rng.uniform();
         const int k_end = lattice_end(t_near, t_far, dt);
         std::vector<uint8_t> taken(size_t(std::max(k_end, 0)), 0);
-        BrickGrid::Cursor cursor(g, cursor_ray(r), t_near, t_far, rng.coin() ? 0.f : dt,
+        BrickGrid::Cursor cursor(g, r, t_near, t_far, rng.coin() ? 0.f : dt,
                                  rng.coin() ? 0.f : 16.f * dt);
         for_each_lattice_run(cursor, t_near, dt, k_end, [&](int kb, int ke) {
             for (int k = kb; k < ke; ++k) taken[size_t(k)] = 1;
@@ -454,8 +454,8 @@ TEST(BrickGrid, FastWalkGivesTheStepWalksStretchesToTheBit) {
                 if (!corner_ray(hi, 1 << g.brick_log2(), rng, r, t_near, t_far)) continue;
                 const float dt = 0.05f + 0.5f * rng.uniform();
                 const float min_skip = rng.coin() ? 0.f : dt, chunk = rng.coin() ? 0.f : 16.f * dt;
-                BrickGrid::Cursor fast(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
-                BrickGrid::Cursor slow(g, cursor_ray(r), t_near, t_far, min_skip, chunk);
+                BrickGrid::Cursor fast(g, r, t_near, t_far, min_skip, chunk);
+                BrickGrid::Cursor slow(g, r, t_near, t_far, min_skip, chunk);
                 Segment a, b;
                 for (int n = 0;; ++n) {
                     ASSERT_LT(n, 100000);

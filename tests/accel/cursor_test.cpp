@@ -17,8 +17,14 @@ namespace {
 
 using namespace accel_test;
 
+// An IndexRay built component by component (the random rays below set o[a] and d[a]).
+struct RayParts {
+    float o[3], d[3];
+    operator IndexRay() const { return IndexRay{o[0], o[1], o[2], d[0], d[1], d[2]}; }
+};
+
 // The marcher's slab test against the index-space box [0, hi] (src/render/ray_marcher.cpp).
-bool intersect_box(const CursorRay& r, const float hi[3], float& t0, float& t1) {
+bool intersect_box(const RayParts& r, const float hi[3], float& t0, float& t1) {
     t0 = 0.f;
     t1 = INFINITY;
     for (int a = 0; a < 3; ++a) {
@@ -38,7 +44,7 @@ bool intersect_box(const CursorRay& r, const float hi[3], float& t0, float& t1) 
 // A random ray that hits the box: origin outside or inside, direction with random anisotropic
 // scale (world-to-index spacing) and sometimes zero components (axis-aligned rays, rays in a
 // face plane).
-bool random_ray(const float hi[3], Rng& rng, CursorRay& r, float& t_near, float& t_far) {
+bool random_ray(const float hi[3], Rng& rng, RayParts& r, float& t_near, float& t_far) {
     for (int attempt = 0; attempt < 100; ++attempt) {
         const bool inside = rng.coin(3);
         for (int a = 0; a < 3; ++a) {
@@ -76,7 +82,7 @@ void check_rays(const S& s, const Volume& v, const T* data, const TransferLut& l
         data, ptrdiff_t(d.x), ptrdiff_t(d.x) * d.y, hi[0], hi[1], hi[2], d.x - 2, d.y - 2, d.z - 2};
     const ValueToLut map = lut.map();
     for (int ray = 0; ray < rays; ++ray) {
-        CursorRay r;
+        RayParts r;
         float t_near, t_far;
         if (!random_ray(hi, rng, r, t_near, t_far)) continue;
         ++stats.rays;
@@ -203,7 +209,7 @@ TEST(Cursor, NoAccelReturnsTheWholeIntervalOnce) {
     Rng rng{66};
     NoAccel none;
     for (int q = 0; q < 1000; ++q) {
-        const CursorRay r{{rng.uniform(), rng.uniform(), rng.uniform()},
+        const RayParts r{{rng.uniform(), rng.uniform(), rng.uniform()},
                           {rng.uniform(), 1.f, -rng.uniform()}};
         const float t_near = 100.f * rng.uniform() - 10.f,
                     t_far = t_near + (q % 10 == 0 ? 0.f : 50.f * rng.uniform());
@@ -228,7 +234,7 @@ TEST(Cursor, TransparentVolumeLeavesOnlyMarginSlivers) {
         accel->set_transfer_function(empty_lut(v.vis_range()));
         const float hi[3] = {16, 11, 8};
         for (int q = 0; q < 200; ++q) {
-            CursorRay r;
+            RayParts r;
             float t_near, t_far;
             if (!random_ray(hi, rng, r, t_near, t_far)) continue;
             float covered = 0, dmax = 0;
