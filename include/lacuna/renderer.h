@@ -137,6 +137,23 @@ void validate_features(const FeatureOptions& f);
 // Sampling::early_termination = nullopt becomes this (src/session/session.cpp).
 inline constexpr float kNoEarlyTermination = 2.f;
 
+// One rank's share of a distributed frame (src/dist/, docs/distributed.md). The marcher's volume
+// is then a brick of a larger grid: its voxel (i, j, k) is the whole grid's voxel offset + (i, j, k),
+// and it keeps the whole grid's geometry (origin, direction, spacing), so rays, t_near, t_far and
+// the lattice t_k are those of the whole grid to the bit. The marcher takes exactly the whole
+// grid's lattice samples whose position p (whole index space, the kernel's own float expression
+// p = o + t_k * d, before the clamp) has lo[a] <= p[a] < hi[a] on every axis; the bricks' owned
+// boxes partition space (the outer faces are -inf / +inf), so every sample of the single-process
+// image is taken by exactly one rank. The brick must hold the voxels [lo, hi] of each finite bound
+// (the cells an owned sample interpolates in). Early ray termination is off on this path (a rank
+// cannot know the opacity in front of its brick), and no features are taken yet.
+struct BrickOwnership {
+    Vec3i whole_dims{0, 0, 0};  // the whole grid's voxels per axis
+    Vec3i offset{0, 0, 0};      // whole-grid index of the brick's voxel (0, 0, 0)
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the owned box, whole index space, half open
+};
+std::string to_string(const BrickOwnership& b);
+
 struct RenderOptions {
     float step = 0.5f;        // sample distance in units of the smallest voxel spacing
     // Trilinear (default) or nearest-neighbour samples (lacuna/accel.h). A structure built for
@@ -149,6 +166,9 @@ struct RenderOptions {
     bool keep_float = false;     // fill RenderResult::rgba_float (tests, error bounds)
     int tile = 16;               // tile edge in pixels (work unit of the thread pool)
     FeatureOptions features;     // shading, lighting, clipping, blend modes, jitter
+    // Distributed rendering: this rank's brick and owned box (nullptr: the whole volume, the
+    // single-process path, untouched).
+    const BrickOwnership* brick = nullptr;
 };
 
 struct RenderStats {

@@ -94,6 +94,13 @@ public:
     // The default table of the label map (colours, label 0 hidden).
     const LabelTable& label_table() const;
 
+    // ---- Distributed rendering (src/dist/, docs/distributed.md): the session's volume is a
+    // brick of a larger grid (BrickOwnership, lacuna/renderer.h); `whole_bounds` is the whole
+    // grid's world box, which the camera frames. Ray-marcher frames then take only the brick's
+    // owned samples, without early termination; other renderers and features are refused.
+    void set_brick(const BrickOwnership& brick, const Box3f& whole_bounds);
+    const std::optional<BrickOwnership>& brick() const { return m_brick; }
+
     // ---- Frames.
     // The camera of a spec (the orbit around bounds(), then the pan).
     Camera camera(const FrameSpec& spec) const;
@@ -130,6 +137,8 @@ private:
     TransferLut m_lut;
     std::optional<TransferLut> m_back_lut;
     uint64_t m_tf_version = 0;  // bumped by every TF change (front or back)
+    std::optional<BrickOwnership> m_brick;
+    Box3f m_whole_bounds{};
     // The renderers and the lazily built structures (src/session/session.cpp).
     struct State;
     std::unique_ptr<State> m_state;

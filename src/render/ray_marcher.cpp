@@ -12,6 +12,7 @@
 #include "core/simd_lanes.h"
 #include "lacuna/error.h"
 #include "render/marcher_cache.h"
+#include "render/ownership.h"
 #include "render/lane_scheduler.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
@@ -204,7 +205,94 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
     }
 }
 
+// Distributed rendering's tile (lacuna/renderer.h BrickOwnership; render/ownership.h): the whole
+// grid's rays, box and lattice, the brick's voxels and structure, the owned samples only. One ray
+// at a time (the lane paths have no ownership clip yet), early termination off.
+template <class T, bool kNearest, class S>
+void render_tile_brick(const S& accel, const Volume& vol, const T* data, const BrickOwnership& own,
+                       const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
+                       ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
+                       std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+    // 1. The whole grid's clamp box and cells with the brick's strides, and the voxel pointer
+    // moved so that a whole-grid offset k*sz + j*sy + i lands on the brick's voxel
+    // (i, j, k) - offset. Owned samples only read voxels of the brick (BrickOwnership's
+    // condition); the moved pointer itself may point outside the buffer, which is why it is
+    // formed by integer arithmetic and only ever dereferenced at in-brick offsets.
+    kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, own.whole_dims);
+    g.sy = ptrdiff_t(vol.dims().x);
+    g.sz = ptrdiff_t(vol.dims().x) * ptrdiff_t(vol.dims().y);
+    const ptrdiff_t shift = ptrdiff_t(own.offset.z) * g.sz + ptrdiff_t(own.offset.y) * g.sy + own.offset.x;
+    g.data = reinterpret_cast<const T*>(reinterpret_cast<uintptr_t>(data) - uintptr_t(shift) * sizeof(T));
+    const Vec3f inv_sp = inverse_spacing(vol);
+    const float dt = sample_distance(vol, opt.step);
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
+    const float off[3] = {float(own.offset.x), float(own.offset.y), float(own.offset.z)};
+    uint64_t tile_samples = 0, tile_rays = 0;
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            const kernel::IndexRay r = index_ray(cam.generate(float(x), float(y)), inv_sp);
+            kernel::Accum acc;
+            uint32_t n = 0;
+            float t_near, t_far;
+            // 2. The whole grid's entry and exit, its lattice, and this rank's run of it.
+            if (kernel::intersect_box(r, hi, t_near, t_far)) {
+                ++tile_rays;
+                const int k_end = lattice_end(t_near, t_far, dt);
+                int ka, kb;
+                owned_run(r, t_near, dt, k_end, own.lo, own.hi, ka, kb);
+                if (ka < kb) {
+                    // 3. The brick's structure walks the ray in brick index space over the run
+                    // and a sample of margin each side; its segments are rounded outward to the
+                    // whole lattice as always (pixel_driver.h), then clipped to the run.
+                    CursorRay cr = cursor_ray(r);
+                    for (int a = 0; a < 3; ++a) cr.o[a] -= off[a];
+                    const float c0 = std::max(t_near, t_near + (float(ka) - 0.5f) * dt);
+                    const float c1 = std::min(t_far, t_near + (float(kb) + 0.5f) * dt);
+                    typename S::Cursor cursor(accel, cr, c0, c1, dt, 0.f);
+                    kernel::RayStream<T, int64_t, kNearest> stream(g, r, t_near, dt, lut.data(),
+                                                                   map, opt.ert, acc);
+                    for_each_lattice_run(cursor, t_near, dt, kb, [&](int b, int e) {
+                        b = std::max(b, ka);
+                        return e > b ? stream.add(b, e) : true;
+                    });
+                    stream.finish();
+                    n = stream.samples();
+                }
+            }
+            tile_samples += n;
+            write_pixel(out, opt, x, y, acc, n);
+        }
+    }
+    samples += tile_samples;
+    rays += tile_rays;
+}
+
+void check_brick(const Volume& vol, const BrickOwnership& b) {
+    const Vec3i d = vol.dims();
+    for (int a = 0; a < 3; ++a) {
+        const bool ok = b.offset[a] >= 0 && b.offset[a] + d[a] <= b.whole_dims[a] &&
+                        (std::isinf(b.lo[a]) || b.lo[a] >= float(b.offset[a])) &&
+                        (std::isinf(b.hi[a]) || b.hi[a] <= float(b.offset[a] + d[a] - 1)) &&
+                        b.lo[a] < b.hi[a];
+        if (!ok)
+            throw Error("render", "brick",
+                        "expected the owned box inside the brick's voxels, got " + to_string(b) +
+                            " for a brick of " + std::to_string(d.x) + "x" + std::to_string(d.y) +
+                            "x" + std::to_string(d.z));
+    }
+}
+
 }  // namespace
+
+std::string to_string(const BrickOwnership& b) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "brick at (%d,%d,%d) of %dx%dx%d, owns [%g,%g) x [%g,%g) x [%g,%g)", b.offset.x,
+                  b.offset.y, b.offset.z, b.whole_dims.x, b.whole_dims.y, b.whole_dims.z,
+                  double(b.lo[0]), double(b.hi[0]), double(b.lo[1]), double(b.hi[1]),
+                  double(b.lo[2]), double(b.hi[2]));
+    return buf;
+}
 
 RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& world_opt) const {
     if (m_lut.entries.empty()) throw Error("render", "transfer function", "none was set");
@@ -223,6 +311,11 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
         opt.interpolation != Interpolation::Nearest)
         throw FrameError("sampling.interpolation",
                          "the structure was built for nearest sampling; expected nearest");
+    if (opt.brick) {
+        if (opt.features.any() || opt.ert < 1.f)
+            throw FrameError("features", "a brick renders without features or early termination");
+        check_brick(m_volume, *opt.brick);
+    }
     if (opt.features.any()) return render_features(cam, opt);
     RenderResult out;
     out.image = Image(cam.width(), cam.height());
@@ -235,6 +328,26 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
     const simd::Isa isa = simd::active_isa();
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = process_cpu_seconds();
+    if (opt.brick) {
+        visit_voxels(m_volume, [&](const auto* data) {
+            static const NoAccel kNone;
+            visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
+                auto frame = [&](auto nearest) {
+                    parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                                       [&](int x0, int y0, int x1, int y1) {
+                                           render_tile_brick<std::remove_cv_t<std::remove_pointer_t<decltype(data)>>,
+                                                             decltype(nearest)::value>(
+                                               s, m_volume, data, *opt.brick, cam, opt, lut, map,
+                                               x0, y0, x1, y1, out, samples, rays);
+                                       });
+                };
+                if (opt.interpolation == Interpolation::Nearest)
+                    frame(std::true_type{});
+                else
+                    frame(std::false_type{});
+            });
+        });
+    } else
     visit_voxels(m_volume, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
         const bool small = m_volume.voxel_count() < (size_t(1) << 31);

@@ -82,7 +82,12 @@ Session::Session(Volume volume, int threads)
 
 Session::~Session() = default;
 
-Box3f Session::bounds() const { return world_bounds(*m_volume); }
+Box3f Session::bounds() const { return m_brick ? m_whole_bounds : world_bounds(*m_volume); }
+
+void Session::set_brick(const BrickOwnership& brick, const Box3f& whole_bounds) {
+    m_brick = brick;
+    m_whole_bounds = whole_bounds;
+}
 
 bool Session::set_transfer_function(const TransferFunction& tf) {
     if (m_has_tf && tf == m_tf) return false;
@@ -116,7 +121,10 @@ const LabelTable& Session::label_table() const {
 
 Camera Session::camera(const FrameSpec& spec) const {
     // The segment renderer frames its label map (the same grid; its geometry may differ).
-    const Box3f b = world_bounds(spec.renderer == Renderer::Segments && m_labels ? *m_labels : *m_volume);
+    const Box3f b = m_brick ? m_whole_bounds
+                            : world_bounds(spec.renderer == Renderer::Segments && m_labels
+                                               ? *m_labels
+                                               : *m_volume);
     OrbitParams op = spec.camera.orbit;
     if (spec.camera.pan_x != 0.f || spec.camera.pan_y != 0.f) {
         // Pan moves the orbit's target along the view plane (the orbit camera's right and up),
@@ -295,6 +303,15 @@ void Session::prepare_segments(const FrameSpec& spec, FrameResult& out) {
 FrameResult Session::prepare(const FrameSpec& spec) {
     validate(spec);
     check_tfs(spec);
+    // A brick session renders its owned samples through the ray marcher's plain path only
+    // (lacuna/renderer.h BrickOwnership).
+    if (m_brick) {
+        if (spec.renderer != Renderer::RayMarcher)
+            throw FrameError("renderer", "distributed rendering takes the ray marcher only");
+        if (spec.features.any() || spec.two_tfs)
+            throw FrameError("features", "distributed rendering takes no features yet "
+                                         "(shading, clipping, crop, blend, jitter, two TFs)");
+    }
     FrameResult out;
     switch (spec.renderer) {
         case Renderer::RayMarcher: prepare_marcher(spec, out); break;
@@ -371,7 +388,16 @@ FrameResult Session::render(const FrameSpec& spec) {
     RenderResult r;
     switch (spec.renderer) {
         case Renderer::RayMarcher:
-            r = s.marcher->render(cam, render_options(spec, m_threads));
+            if (m_brick) {
+                // Every rank marches its rays to their end: the opacity in front of its brick
+                // is another rank's.
+                RenderOptions ro = render_options(spec, m_threads);
+                ro.ert = kNoEarlyTermination;
+                ro.brick = &*m_brick;
+                r = s.marcher->render(cam, ro);
+            } else {
+                r = s.marcher->render(cam, render_options(spec, m_threads));
+            }
             break;
         case Renderer::Slicer: {
             // The adaptive controller learns over consecutive frames of one structure and

@@ -1,0 +1,48 @@
+// The one place distributed rendering talks to MPI (STYLE.md habit 6: like threading and SIMD,
+// message passing lives in one file). Built over MPI (comm_mpi.cpp) when CMake finds it, else
+// over a one-process stand-in (comm_single.cpp) with the same interface, so everything above it
+// (decomposition, compositing, the distributed frame) compiles and is tested without MPI.
+//
+// MPI is initialised lazily, and only when the process was started by a launcher (mpirun sets
+// OMPI_COMM_WORLD_SIZE, PMI_SIZE or PMIX_RANK): a plain `lacuna render` never touches MPI, and
+// its behaviour is unchanged. Finalised at exit.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace lacuna::dist {
+
+// True when this process was started by an MPI launcher and lacuna was built with MPI.
+bool launched();
+// The launcher's rank of this process from its environment, without initialising MPI (0 when
+// not launched): the CLI prints errors on rank 0 only.
+int launcher_rank();
+
+// COMM_WORLD (initialising MPI on first use when launched; one process of rank 0 otherwise).
+class Comm {
+public:
+    static Comm& world();
+    int rank() const { return m_rank; }
+    int size() const { return m_size; }
+
+    void barrier();
+    // Raw bytes, blocking. Tags keep the compositing rounds apart.
+    void send(int to, int tag, const void* data, size_t bytes);
+    void recv(int from, int tag, void* data, size_t bytes);
+    // Exchanges with `peer` at once (no deadlock whichever side is first).
+    void sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* in, size_t in_bytes);
+    // Every rank's `mine` (the same size everywhere) on rank 0, in rank order.
+    std::vector<uint8_t> gather(const void* mine, size_t bytes);
+    // Every rank's `mine` on every rank, in rank order.
+    std::vector<uint8_t> allgather(const void* mine, size_t bytes);
+    // Ends every rank of the job with this exit code (after a rank's error: the others may be
+    // waiting in a collective).
+    [[noreturn]] void abort(int code);
+
+private:
+    Comm();
+    int m_rank = 0, m_size = 1;
+};
+
+}  // namespace lacuna::dist

@@ -1,0 +1,116 @@
+// dist::Comm over MPI (src/dist/comm.h): the only file that includes <mpi.h>.
+#include <mpi.h>
+
+#include <climits>
+#include <cstdlib>
+
+#include "dist/comm.h"
+#include "lacuna/error.h"
+
+namespace lacuna::dist {
+
+namespace {
+
+const char* env(const char* name) {
+    const char* v = std::getenv(name);
+    return v && *v ? v : nullptr;
+}
+
+void finalize_at_exit() {
+    int done = 0;
+    MPI_Finalized(&done);
+    if (!done) MPI_Finalize();
+}
+
+// Messages larger than INT_MAX bytes go in pieces (MPI counts are int).
+constexpr size_t kPiece = size_t(1) << 30;
+
+}  // namespace
+
+bool launched() {
+    return env("OMPI_COMM_WORLD_SIZE") || env("PMI_SIZE") || env("PMIX_RANK");
+}
+
+int launcher_rank() {
+    for (const char* n : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+        if (const char* v = env(n)) return std::atoi(v);
+    return 0;
+}
+
+Comm::Comm() {
+    if (!launched()) return;  // one process; MPI untouched
+    int init = 0;
+    MPI_Initialized(&init);
+    if (!init) {
+        int provided = 0;
+        // Only the thread that called world() talks to MPI (the render's worker threads never do).
+        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+        std::atexit(finalize_at_exit);
+    }
+    MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &m_size);
+}
+
+Comm& Comm::world() {
+    static Comm c;
+    return c;
+}
+
+void Comm::barrier() {
+    if (m_size > 1) MPI_Barrier(MPI_COMM_WORLD);
+}
+
+void Comm::send(int to, int tag, const void* data, size_t bytes) {
+    const auto* p = static_cast<const char*>(data);
+    do {
+        const size_t n = bytes < kPiece ? bytes : kPiece;
+        MPI_Send(p, int(n), MPI_BYTE, to, tag, MPI_COMM_WORLD);
+        p += n;
+        bytes -= n;
+    } while (bytes > 0);
+}
+
+void Comm::recv(int from, int tag, void* data, size_t bytes) {
+    auto* p = static_cast<char*>(data);
+    do {
+        const size_t n = bytes < kPiece ? bytes : kPiece;
+        MPI_Recv(p, int(n), MPI_BYTE, from, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        p += n;
+        bytes -= n;
+    } while (bytes > 0);
+}
+
+void Comm::sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* in, size_t in_bytes) {
+    const auto* o = static_cast<const char*>(out);
+    auto* i = static_cast<char*>(in);
+    // Both sides walk the same number of pieces: the larger of the two sizes decides.
+    do {
+        const size_t no = out_bytes < kPiece ? out_bytes : kPiece;
+        const size_t ni = in_bytes < kPiece ? in_bytes : kPiece;
+        MPI_Sendrecv(o, int(no), MPI_BYTE, peer, tag, i, int(ni), MPI_BYTE, peer, tag,
+                     MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        o += no, i += ni;
+        out_bytes -= no, in_bytes -= ni;
+    } while (out_bytes > 0 || in_bytes > 0);
+}
+
+std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
+    if (bytes > size_t(INT_MAX)) throw Error("mpi", "gather", "expected under 2 GiB per rank");
+    std::vector<uint8_t> all(m_rank == 0 ? bytes * size_t(m_size) : 0);
+    MPI_Gather(mine, int(bytes), MPI_BYTE, all.data(), int(bytes), MPI_BYTE, 0, MPI_COMM_WORLD);
+    return all;
+}
+
+std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
+    if (bytes > size_t(INT_MAX)) throw Error("mpi", "allgather", "expected under 2 GiB per rank");
+    std::vector<uint8_t> all(bytes * size_t(m_size));
+    MPI_Allgather(mine, int(bytes), MPI_BYTE, all.data(), int(bytes), MPI_BYTE, MPI_COMM_WORLD);
+    return all;
+}
+
+void Comm::abort(int code) {
+    if (m_size > 1) MPI_Abort(MPI_COMM_WORLD, code);
+    std::exit(code);
+}
+
+}  // namespace lacuna::dist
