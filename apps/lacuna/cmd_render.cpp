@@ -20,6 +20,7 @@
 #include "movie.h"
 #include "io/io_util.h"
 #include "session/session_file.h"
+#include "render_mpi.h"
 #include "render_slice.h"
 #include "segments_cli.h"
 
@@ -66,6 +67,7 @@ struct RenderArgs {
     FeatureArgs features;  // shading, lights, clipping, blend modes (feature_args.h)
     SegmentArgs segments;
     SliceCliArgs slice;  // --renderer, --occlusion* (render_slice.h)
+    MpiCliArgs mpi;      // --balance, --composite, --rank-times (under mpirun; render_mpi.h)
 };
 
 Vec3f parse_rgb(const std::string& s) {
@@ -227,6 +229,7 @@ Setup validate(RenderArgs& a) {
     if (a.frames < 2 || a.frames > 100000) throw Error("--frames", "frames", "expected 2..100000");
     if (a.repeat < 1 || a.repeat > 100000) throw Error("--repeat", "frames", "expected 1..100000");
     check_slice_options(a.slice, !a.tf_animate.empty(), !a.heatmap.empty());
+    check_mpi_options(a.mpi);
     if (!a.tf_animate.empty() && !a.features.tf_back.empty())
         throw Error("--tf-back", "transfer function", "not supported with --tf-animate");
     if (a.segments.active() && !a.tf_animate.empty())
@@ -457,6 +460,8 @@ void render_frames(RenderArgs& a, const Setup& s) {
                               : s.spec.renderer == Renderer::Segments ? "bitfield"
                               : s.spec.renderer == Renderer::Slicer   ? "none"
                                                                       : a.accel;
+    if (mpi_render_active() && s.spec.renderer != Renderer::RayMarcher)
+        throw Error("mpirun", "renderer", "the ray marcher only (not --renderer slice or segments)");
     switch (s.spec.renderer) {
         case Renderer::Segments: {
             Progress summary("render", 1, "frame");
@@ -474,6 +479,16 @@ void render_frames(RenderArgs& a, const Setup& s) {
             return;
         }
         case Renderer::RayMarcher:
+            if (mpi_render_active()) {
+                // Under mpirun: one frame by every rank (render_mpi.h).
+                if (a.orbit || !a.tf_animate.empty() || a.repeat != 1 || !a.heatmap.empty() ||
+                    !a.movie.empty())
+                    throw Error("mpirun", "frames",
+                                "one frame per run under mpirun (not --orbit, --tf-animate, "
+                                "--repeat, --heatmap or --movie yet)");
+                render_mpi({a.volume, front_tf(a), accel, a.out, a.threads, s.spec, a.mpi});
+                return;
+            }
             if (a.orbit)
                 render_orbit(a, s);
             else if (a.tf_animate.empty())
@@ -570,6 +585,7 @@ void register_render(CLI::App& app) {
     add_feature_args(*cmd, a->features);
     add_segment_args(*cmd, a->segments);
     add_slice_options(*cmd, a->slice);
+    add_mpi_options(*cmd, a->mpi);
     cmd->callback([a, cmd] {
         a->slice.threshold_given = cmd->count("--occlusion-threshold") > 0;
         a->slice.map_given = cmd->count("--occlusion-map") > 0;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli_common.h"
+#include "dist/comm.h"
 #include "frame_flags.h"
 #include "lacuna/error.h"
 
@@ -53,6 +54,11 @@ void add_quiet(CLI::App& app) {
     for (CLI::App* s : app.get_subcommands([](const CLI::App*) { return true; })) add_quiet(*s);
 }
 
+// Under mpirun every rank parses the same flags and fails alike: rank 0 alone prints the line.
+void error_line(const std::string& line) {
+    if (lacuna::dist::launcher_rank() == 0) std::fprintf(stderr, "lacuna: %s\n", line.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,21 +82,20 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "lacuna: %s (see --help)\n", e.what());
+        error_line(std::string(e.what()) + " (see --help)");
         return 2;
     } catch (const lacuna::FrameError& e) {
         // The library names FrameSpec fields; the user typed flags (frame_flags.cpp).
-        std::fprintf(stderr, "lacuna: %s: %s: %s\n", lacuna::cli::flag_of_field(e.field()).c_str(),
-                     e.field().c_str(), e.expected().c_str());
+        error_line(lacuna::cli::flag_of_field(e.field()) + ": " + e.field() + ": " + e.expected());
         return 2;
     } catch (const lacuna::Error& e) {
-        std::fprintf(stderr, "lacuna: %s\n", lacuna::cli::with_flag(e.what()).c_str());
+        error_line(lacuna::cli::with_flag(e.what()));
         return 2;
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "lacuna: out of memory\n");
+        error_line("out of memory");
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "lacuna: internal error: %s\n", e.what());
+        error_line(std::string("internal error: ") + e.what());
         return 3;
     }
     return 0;

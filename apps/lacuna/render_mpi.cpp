@@ -1,0 +1,105 @@
+#include "render_mpi.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "core/parallel.h"
+#include "dist/comm.h"
+#include "dist/distributed_frame.h"
+#include "lacuna/error.h"
+
+namespace lacuna::cli {
+
+namespace {
+
+dist::Balance parse_balance(const std::string& s) {
+    if (s == "voxels") return dist::Balance::Voxels;
+    if (s == "visible") return dist::Balance::Visible;
+    throw Error("--balance", "balance", "expected voxels or visible, got '" + s + "'");
+}
+
+dist::Composite parse_composite(const std::string& s) {
+    if (s == "direct") return dist::Composite::Direct;
+    if (s == "binary-swap") return dist::Composite::BinarySwap;
+    throw Error("--composite", "compositing", "expected direct or binary-swap, got '" + s + "'");
+}
+
+}  // namespace
+
+void add_mpi_options(CLI::App& cmd, MpiCliArgs& a) {
+    cmd.add_option("--balance", a.balance,
+                   "Under mpirun: kd-tree bricks balanced on voxels, or on the cells the TF can "
+                   "make visible (docs/distributed.md)")
+        ->capture_default_str();
+    cmd.add_option("--composite", a.composite,
+                   "Under mpirun: sort-last compositing, direct (to rank 0) or binary-swap")
+        ->capture_default_str();
+    cmd.add_flag("--rank-times", a.rank_times,
+                 "Under mpirun: rank 0 prints each rank's load, build, render and composite times");
+}
+
+bool mpi_render_active() { return dist::launched(); }
+
+void check_mpi_options(const MpiCliArgs& a) {
+    parse_balance(a.balance);
+    parse_composite(a.composite);
+}
+
+void render_mpi(const MpiRenderJob& job) {
+    dist::Comm& comm = dist::Comm::world();
+    dist::DistOptions o;
+    o.balance = parse_balance(job.mpi.balance);
+    o.composite = parse_composite(job.mpi.composite);
+    // What every rank refuses alike, before any rank starts (one line from rank 0, main.cpp).
+    if (job.spec.features.any() || job.spec.two_tfs)
+        throw Error("mpirun", "features",
+                    "distributed rendering takes no features yet (shading, gradient opacity, "
+                    "shadows, clip planes, crop, blend modes, jitter, --tf-back)");
+    dist::DistFrame f;
+    try {
+        f = dist::render_distributed(
+            comm, [&] { return load_volume(job.volume); }, job.tf, job.spec, o, job.threads);
+    } catch (const Error& e) {
+        // A rank's own failure (its brick, its memory): the others may wait in a collective,
+        // so the job ends here with the CLI's exit code for errors.
+        if (comm.size() == 1) throw;
+        std::fprintf(stderr, "lacuna: rank %d: %s\n", comm.rank(), e.what());
+        comm.abort(2);
+    }
+    if (comm.rank() != 0) return;
+    write_png(job.out, f.image);
+    const FrameSpec& s = job.spec;
+    uint64_t samples = 0, rays = 0, voxels = 0, bytes = 0;
+    double slowest = 0;
+    for (const auto& r : f.ranks) {
+        samples += r.samples, rays = std::max<uint64_t>(rays, r.rays), voxels += r.voxels;
+        bytes += r.bytes_sent;
+        slowest = std::max(slowest, r.render_seconds);
+    }
+    std::printf("%s: %dx%d %s, tf %s, accel %s, %d ranks (%s, %s compositing), %d threads per rank\n",
+                job.volume.path.c_str(), s.width, s.height,
+                s.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
+                job.tf.name.c_str(), job.accel.c_str(), comm.size(), dist::to_string(o.balance).c_str(),
+                dist::to_string(o.composite).c_str(), resolve_threads(job.threads));
+    if (s.sampling.early_termination)
+        std::printf("early ray termination: off (a rank cannot see the opacity in front of its brick)\n");
+    std::printf("bricks: %s\n", dist::to_string(f.decomposition).c_str());
+    std::printf("frame %.1f ms (slowest rank's render %.1f ms), %llu samples, %.1f MiB composited\n",
+                f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
+                double(bytes) / (1 << 20));
+    if (job.mpi.rank_times) {
+        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %10s\n", "rank", "load ms", "build ms",
+                    "render ms", "composite ms", "CPU ms", "samples", "voxels%", "sent KiB");
+        for (const auto& r : f.ranks)
+            std::printf("%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %10.1f\n", r.rank,
+                        r.load_seconds * 1e3, r.build_seconds * 1e3, r.render_seconds * 1e3,
+                        r.composite_seconds * 1e3, r.cpu_seconds * 1e3,
+                        (unsigned long long)r.samples,
+                        100.0 * double(r.voxels) / double(std::max<uint64_t>(f.whole_voxels, 1)),
+                        double(r.bytes_sent) / 1024);
+    }
+    std::printf("wrote %s\n", job.out.c_str());
+    std::fflush(stdout);
+}
+
+}  // namespace lacuna::cli

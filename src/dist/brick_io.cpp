@@ -1,0 +1,33 @@
+#include "dist/brick_io.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "lacuna/error.h"
+
+namespace lacuna::dist {
+
+Volume crop_brick(const Volume& whole, Vec3i offset, Vec3i dims) {
+    const Vec3i wd = whole.dims();
+    for (int a = 0; a < 3; ++a)
+        if (offset[a] < 0 || dims[a] < 2 || offset[a] + dims[a] > wd[a])
+            throw Error("brick", "voxels", "expected a brick inside the volume");
+    Volume b(dims, whole.type(), "brick");
+    const size_t vs = voxel_size(whole.type());
+    const auto* src = static_cast<const uint8_t*>(whole.data());
+    auto* dst = static_cast<uint8_t*>(b.data());
+    const size_t row = size_t(dims.x) * vs;
+    for (int k = 0; k < dims.z; ++k)
+        for (int j = 0; j < dims.y; ++j)
+            std::memcpy(dst + b.index(0, j, k) * vs,
+                        src + whole.index(offset.x, offset.y + j, offset.z + k) * vs, row);
+    b.spacing = whole.spacing;
+    b.origin = whole.origin;
+    std::copy_n(whole.direction, 9, b.direction);
+    b.geometry_source = whole.geometry_source;
+    b.compute_range("brick");
+    b.set_vis_range(whole.vis_range());
+    return b;
+}
+
+}  // namespace lacuna::dist

@@ -1,0 +1,99 @@
+#include "dist/distributed_frame.h"
+
+#include <chrono>
+#include <cstring>
+
+#include "dist/brick_io.h"
+#include "lacuna/orientation.h"
+#include "lacuna/session.h"
+#include "render/pixel_driver.h"
+
+namespace lacuna::dist {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const TransferFunction& tf,
+                             const FrameSpec& spec, const DistOptions& options, int threads) {
+    DistFrame out;
+    RankReport me;
+    me.rank = comm.rank();
+    // 1. The whole grid, its decomposition, this rank's brick.
+    auto t0 = Clock::now();
+    Box3f whole_bounds;
+    Volume brick;
+    BrickOwnership own;
+    {
+        const Volume whole = load();
+        whole_bounds = world_bounds(whole);
+        out.whole_voxels = whole.voxel_count();
+        out.decomposition = options.balance == Balance::Visible
+                                ? decompose_visible(whole, discretise(tf, whole.vis_range()),
+                                                    comm.size(), threads)
+                                : decompose_voxels(whole.dims(), comm.size());
+        own = ownership(out.decomposition, comm.rank());
+        brick = crop_brick(whole, own.offset, brick_voxels(out.decomposition, comm.rank()));
+    }
+    me.load_seconds = seconds_since(t0);
+    me.voxels = brick.voxel_count();
+    // 2. The brick's session: its structure, then its owned samples.
+    Session session(std::move(brick), threads);
+    session.set_brick(own, whole_bounds);
+    session.set_transfer_function(tf);
+    FrameSpec f = spec;
+    f.keep_float = true;
+    f.count_samples = false;
+    t0 = Clock::now();
+    session.prepare(f);
+    session.refine();
+    me.build_seconds = seconds_since(t0);
+    comm.barrier();  // the frame's time starts when every rank is ready
+    const auto frame0 = Clock::now();
+    FrameResult r = session.render(f);
+    me.render_seconds = r.stats.seconds;
+    me.cpu_seconds = r.stats.cpu_seconds;
+    me.samples = r.stats.samples;
+    me.rays = r.stats.rays;
+    // 3. Compositing in the kd-tree's order for this view (eye and ray direction in whole index
+    // space: the volume frame over the spacing).
+    const Camera cam = to_volume_frame(volume_frame(session.volume()), session.camera(f));
+    const Vec3d sp = session.volume().spacing;
+    const Vec3f inv{float(1.0 / sp.x), float(1.0 / sp.y), float(1.0 / sp.z)};
+    const Vec3f eye = cam.eye() * inv, dir = cam.forward() * inv;
+    const bool ortho = cam.projection() == Projection::Orthographic;
+    Partial mine{f.width, f.height, std::move(r.rgba_float)};
+    CompositeStats cs;
+    Partial done = options.composite == Composite::Direct
+                       ? composite_direct(comm, mine,
+                                          visibility_order(out.decomposition, eye, dir, ortho), cs)
+                       : composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir,
+                                               ortho, cs);
+    me.composite_seconds = cs.seconds;
+    me.bytes_sent = cs.bytes_sent;
+    if (comm.rank() == 0) {
+        // The single-process pixel rule (pixel_driver.h): background behind, clamp, round.
+        out.image = Image(f.width, f.height);
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const float* c = done.at(x, y);
+                const uint32_t w = pixel_word(f.background, kernel::Accum{c[0], c[1], c[2], c[3]});
+                std::memcpy(out.image.pixel(x, y), &w, 4);
+            }
+        out.frame_seconds = seconds_since(frame0);
+    }
+    // 4. Every rank's report on rank 0.
+    const std::vector<uint8_t> all = comm.gather(&me, sizeof me);
+    if (comm.rank() == 0) {
+        out.ranks.resize(size_t(comm.size()));
+        std::memcpy(out.ranks.data(), all.data(), all.size());
+    }
+    return out;
+}
+
+}  // namespace lacuna::dist

@@ -1,0 +1,63 @@
+// One frame rendered by every rank of a job (docs/distributed.md): the front ends' entry.
+//
+// Every rank calls render_distributed with the same FrameSpec and TF (the CLI's flags, parsed the
+// same way on every rank). Each rank
+//   1. loads its brick (brick_io.h) of the decomposition (decomposition.h), computed the same way
+//      on every rank from the whole grid (and, for Balance::Visible, the TF);
+//   2. runs an ordinary Session over the brick (Session::set_brick): the structure of the frame is
+//      built over the brick, and the ray marcher takes only the brick's owned samples of the whole
+//      grid's lattice (render/ownership.h), without early ray termination;
+//   3. composites its partial float image with the others' (composite.h); rank 0 ends with the
+//      frame, the background composited and rounded by the single-process pixel rule.
+// So the frame equals the single-process frame rendered with early termination off (--ert 1), up
+// to the float association of compositing (within 1/255 per channel; tests/dist/).
+#pragma once
+#include <functional>
+#include <vector>
+
+#include "dist/comm.h"
+#include "dist/composite.h"
+#include "dist/decomposition.h"
+#include "lacuna/frame_spec.h"
+#include "lacuna/image.h"
+#include "lacuna/renderer.h"
+#include "lacuna/transfer_function.h"
+#include "lacuna/volume.h"
+
+namespace lacuna::dist {
+
+struct DistOptions {
+    Balance balance = Balance::Voxels;
+    Composite composite = Composite::Direct;
+};
+
+// One rank's account of the frame (plain data: gathered on rank 0 as bytes).
+struct RankReport {
+    int32_t rank = 0;
+    int32_t pad = 0;
+    double load_seconds = 0;       // read the file and cut the brick out
+    double build_seconds = 0;      // the brick's structure (and its per-TF refinement)
+    double render_seconds = 0;     // the rank's owned samples
+    double composite_seconds = 0;  // this rank's part of compositing
+    double cpu_seconds = 0;        // CPU time of the render (all its threads)
+    uint64_t samples = 0, rays = 0;
+    uint64_t voxels = 0;           // voxels of the brick (ghost layer included)
+    uint64_t visible_cells = 0;    // cells of the brick's box the TF can make visible (0: not counted)
+    uint64_t bytes_sent = 0;       // compositing
+};
+
+struct DistFrame {
+    Image image;                     // rank 0 only
+    std::vector<RankReport> ranks;   // rank 0 only, in rank order
+    Decomposition decomposition;
+    uint64_t whole_voxels = 0;
+    double frame_seconds = 0;        // rank 0: from the render's start to the composited image
+};
+
+// The whole volume once per rank, through the front end's reader.
+using VolumeLoader = std::function<Volume()>;
+
+DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const TransferFunction& tf,
+                             const FrameSpec& spec, const DistOptions& options, int threads);
+
+}  // namespace lacuna::dist
