@@ -80,7 +80,7 @@ void render_mpi(const MpiRenderJob& job) {
                 job.volume.path.c_str(), s.width, s.height,
                 s.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
                 job.tf.name.c_str(), job.accel.c_str(), comm.size(), dist::to_string(o.balance).c_str(),
-                dist::to_string(o.composite).c_str(), resolve_threads(job.threads));
+                dist::to_string(o.composite).c_str(), dist::rank_threads(job.threads));
     if (s.sampling.early_termination)
         std::printf("early ray termination: off (a rank cannot see the opacity in front of its brick)\n");
     std::printf("bricks: %s\n", dist::to_string(f.decomposition).c_str());

@@ -1,4 +1,7 @@
 // dist::Comm over MPI (src/dist/comm.h): the only file that includes <mpi.h>.
+// The C API only (the deprecated C++ bindings warn under -Wextra).
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
 #include <mpi.h>
 
 #include <climits>

@@ -1,10 +1,13 @@
 #include "dist/distributed_frame.h"
 
+#include <sched.h>
+
 #include <chrono>
 #include <cstring>
 
 #include "dist/brick_io.h"
 #include "lacuna/orientation.h"
+#include "core/parallel.h"
 #include "lacuna/session.h"
 #include "render/pixel_driver.h"
 
@@ -19,8 +22,19 @@ double seconds_since(Clock::time_point t0) {
 
 }  // namespace
 
+int rank_threads(int requested) {
+    if (requested > 0) return requested;
+    // mpirun binds each rank to its share of the cores (unless oversubscribed): all of them
+    // would be more threads than this rank may run (TBB warns and caps them).
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+    return resolve_threads(0);
+}
+
 DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const TransferFunction& tf,
                              const FrameSpec& spec, const DistOptions& options, int threads) {
+    threads = rank_threads(threads);
     DistFrame out;
     RankReport me;
     me.rank = comm.rank();

@@ -57,6 +57,11 @@ struct DistFrame {
 // The whole volume once per rank, through the front end's reader.
 using VolumeLoader = std::function<Volume()>;
 
+// Worker threads of a rank: `requested`, or for 0 the cores this process may run on (its CPU
+// affinity, which mpirun sets when it binds ranks to cores).
+int rank_threads(int requested);
+
+// `threads` as rank_threads() resolves it.
 DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const TransferFunction& tf,
                              const FrameSpec& spec, const DistOptions& options, int threads);
 

@@ -329,14 +329,15 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = process_cpu_seconds();
     if (opt.brick) {
+        // Distributed rendering: the owned samples of this brick (render_tile_brick).
         visit_voxels(m_volume, [&](const auto* data) {
+            using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
             static const NoAccel kNone;
             visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
                 auto frame = [&](auto nearest) {
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
-                                           render_tile_brick<std::remove_cv_t<std::remove_pointer_t<decltype(data)>>,
-                                                             decltype(nearest)::value>(
+                                           render_tile_brick<T, decltype(nearest)::value>(
                                                s, m_volume, data, *opt.brick, cam, opt, lut, map,
                                                x0, y0, x1, y1, out, samples, rays);
                                        });
@@ -347,26 +348,27 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
                     frame(std::false_type{});
             });
         });
-    } else
-    visit_voxels(m_volume, [&](const auto* data) {
-        using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
-        const bool small = m_volume.voxel_count() < (size_t(1) << 31);
-        static const NoAccel kNone;
-        visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
-            auto frame = [&](auto nearest) {
-                parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
-                                   [&](int x0, int y0, int x1, int y1) {
-                                       render_tile_on<T, decltype(nearest)::value>(
-                                           isa, small, s, m_volume, data, cam, opt, lut, map, x0,
-                                           y0, x1, y1, out, samples, rays);
-                                   });
-            };
-            if (opt.interpolation == Interpolation::Nearest)
-                frame(std::true_type{});
-            else
-                frame(std::false_type{});
+    } else {
+        visit_voxels(m_volume, [&](const auto* data) {
+            using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
+            const bool small = m_volume.voxel_count() < (size_t(1) << 31);
+            static const NoAccel kNone;
+            visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
+                auto frame = [&](auto nearest) {
+                    parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
+                                       [&](int x0, int y0, int x1, int y1) {
+                                           render_tile_on<T, decltype(nearest)::value>(
+                                               isa, small, s, m_volume, data, cam, opt, lut, map, x0,
+                                               y0, x1, y1, out, samples, rays);
+                                       });
+                };
+                if (opt.interpolation == Interpolation::Nearest)
+                    frame(std::true_type{});
+                else
+                    frame(std::false_type{});
+            });
         });
-    });
+    }
     const auto t1 = std::chrono::steady_clock::now();
     out.stats.seconds = std::chrono::duration<double>(t1 - t0).count();
     out.stats.cpu_seconds = process_cpu_seconds() - cpu0;

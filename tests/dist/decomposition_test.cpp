@@ -129,7 +129,7 @@ TEST(Decomposition, VisibilityOrderFollowsEveryRay) {
             const Vec3f eye{-20.f + 70.f * rng.uniform(), -20.f + 65.f * rng.uniform(), -20.f + 60.f * rng.uniform()};
             Vec3f dir{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f};
             const std::vector<int> order = visibility_order(d, eye, dir, ortho);
-            std::vector<int> pos(size_t(n));
+            std::vector<int> pos(static_cast<size_t>(n));
             for (int i = 0; i < n; ++i) pos[size_t(order[size_t(i)])] = i;
             ASSERT_EQ(order.size(), size_t(n));
             for (int ray = 0; ray < 20; ++ray) {

@@ -101,7 +101,7 @@ TEST(DistributedFrame, BricksTakeEverySampleOnceAndMatchOneProcess) {
     SyntheticOptions o;
     o.dims = {37, 30, 41};
     o.threads = 1;
-    const Volume whole = generate(SyntheticKind::NoiseBlobs, o);
+    const Volume whole = generate(SyntheticKind::SphereShells, o);
     const TransferFunction tf = test_tf();
     const Case cases[] = {{"none", structure::None{}},
                           {"grid", structure::Grid{}},

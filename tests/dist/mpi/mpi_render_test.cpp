@@ -58,10 +58,12 @@ size_t expect_close(const fs::path& a, const fs::path& b, const std::string& wha
     return differ;
 }
 
-const fs::path& tree_volume() {
+// Nested shells under a TF that keeps most of them half transparent: long front-to-back chains
+// in most pixels, so compositing's float association gets every chance to show.
+const fs::path& shells_volume() {
     static const fs::path v = [] {
-        const fs::path p = dir() / "tree.nrrd";
-        const CliResult r = run_cli("generate noise-blobs --dims 45x38x52 --out " + p.string() + " --quiet", dir());
+        const fs::path p = dir() / "shells.nrrd";
+        const CliResult r = run_cli("generate sphere-shells --dims 45x38x52 --out " + p.string() + " --quiet", dir());
         EXPECT_EQ(r.code, 0) << r.err;
         return p;
     }();
@@ -85,23 +87,23 @@ void check_frames(const std::string& volume, const std::string& frame, const std
         }
 }
 
-constexpr const char* kFrame = "--tf ct-soft-tissue --size 64 --azimuth 40 --elevation 25";
+constexpr const char* kFrame = "--tf mr-default --size 64 --azimuth 40 --elevation 25 --zoom 1.6";
 
 TEST(MpiRender, NoneOnEveryRankCount) {
-    check_frames(tree_volume().string(), std::string(kFrame) + " --accel none", "none",
+    check_frames(shells_volume().string(), std::string(kFrame) + " --accel none", "none",
                  {1, 2, 3, 4, 7}, {"direct", "binary-swap"});
 }
 
 TEST(MpiRender, GridBitfieldKdtreeMatchOneProcess) {
     for (const char* accel : {"auto", "bitfield", "kdtree"})
-        check_frames(tree_volume().string(), std::string(kFrame) + " --accel " + accel, accel,
+        check_frames(shells_volume().string(), std::string(kFrame) + " --accel " + accel, accel,
                      {2, 3, 4, 7}, {accel[0] == 'b' ? "binary-swap" : "direct"});
 }
 
 TEST(MpiRender, VisibleBalanceOrthographicAndInside) {
-    check_frames(tree_volume().string(), std::string(kFrame) + " --ortho --balance visible", "ortho",
+    check_frames(shells_volume().string(), std::string(kFrame) + " --ortho --balance visible", "ortho",
                  {3, 4}, {"direct", "binary-swap"});
-    check_frames(tree_volume().string(), "--tf ct-soft-tissue --size 48 --zoom 3.5 --accel grid",
+    check_frames(shells_volume().string(), "--tf mr-default --size 48 --zoom 3.5 --accel grid",
                  "inside", {2, 7}, {"binary-swap"});
 }
 
@@ -114,7 +116,7 @@ TEST(MpiRender, Ch2HeadMatchesOneProcess) {
 
 TEST(MpiRender, OnlyRankZeroWritesAndReports) {
     const fs::path out = dir() / "rank0.png";
-    const CliResult m = run_mpi(3, "render " + tree_volume().string() + " " + kFrame +
+    const CliResult m = run_mpi(3, "render " + shells_volume().string() + " " + kFrame +
                                        " --rank-times --out " + out.string());
     ASSERT_EQ(m.code, 0) << m.err;
     EXPECT_TRUE(fs::exists(out));
@@ -127,7 +129,7 @@ TEST(MpiRender, OnlyRankZeroWritesAndReports) {
 
 TEST(MpiRender, RefusedFramesAreOneLineFromRankZero) {
     for (const char* flags : {"--shading phong", "--orbit 3", "--renderer slice"}) {
-        const CliResult m = run_mpi(2, "render " + tree_volume().string() + " " + kFrame + " " +
+        const CliResult m = run_mpi(2, "render " + shells_volume().string() + " " + kFrame + " " +
                                            flags + " --out " + (dir() / "refused.png").string());
         EXPECT_NE(m.code, 0) << flags;
         size_t lines = 0;
