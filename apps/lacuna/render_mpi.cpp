@@ -38,7 +38,9 @@ void add_mpi_options(CLI::App& cmd, MpiCliArgs& a) {
                  "Under mpirun: rank 0 prints each rank's load, build, render and composite times");
 }
 
-bool mpi_render_active() { return dist::launched(); }
+bool mpi_render_active() {
+    return dist::launched();
+}
 
 void check_mpi_options(const MpiCliArgs& a) {
     parse_balance(a.balance);
@@ -76,17 +78,20 @@ void render_mpi(const MpiRenderJob& job) {
         bytes += r.bytes_sent;
         slowest = std::max(slowest, r.render_seconds);
     }
-    std::printf("%s: %dx%d %s, tf %s, accel %s, %d ranks (%s, %s compositing), %d threads per rank\n",
-                job.volume.path.c_str(), s.width, s.height,
-                s.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
-                job.tf.name.c_str(), job.accel.c_str(), comm.size(), dist::to_string(o.balance).c_str(),
-                dist::to_string(o.composite).c_str(), dist::rank_threads(job.threads));
+    std::printf(
+        "%s: %dx%d %s, tf %s, accel %s, %d ranks (%s, %s compositing), %d threads per rank\n",
+        job.volume.path.c_str(), s.width, s.height,
+        s.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
+        job.tf.name.c_str(), job.accel.c_str(), comm.size(), dist::to_string(o.balance).c_str(),
+        dist::to_string(o.composite).c_str(), dist::rank_threads(job.threads));
     if (s.sampling.early_termination)
-        std::printf("early ray termination: off (a rank cannot see the opacity in front of its brick)\n");
+        std::printf(
+            "early ray termination: off (a rank cannot see the opacity in front of its brick)\n");
     std::printf("bricks: %s\n", dist::to_string(f.decomposition).c_str());
-    std::printf("frame %.1f ms (slowest rank's render %.1f ms), %llu samples, %.1f MiB composited\n",
-                f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
-                double(bytes) / (1 << 20));
+    std::printf(
+        "frame %.1f ms (slowest rank's render %.1f ms), %llu samples, %.1f MiB composited\n",
+        f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
+        double(bytes) / (1 << 20));
     if (job.mpi.rank_times) {
         std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %10s\n", "rank", "load ms", "build ms",
                     "render ms", "composite ms", "CPU ms", "samples", "voxels%", "sent KiB");

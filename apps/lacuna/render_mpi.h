@@ -10,9 +10,9 @@
 namespace lacuna::cli {
 
 struct MpiCliArgs {
-    std::string balance = "voxels";     // --balance voxels|visible
-    std::string composite = "direct";   // --composite direct|binary-swap
-    bool rank_times = false;            // --rank-times: rank 0 prints every rank's times
+    std::string balance = "voxels";    // --balance voxels|visible
+    std::string composite = "direct";  // --composite direct|binary-swap
+    bool rank_times = false;           // --rank-times: rank 0 prints every rank's times
 };
 void add_mpi_options(CLI::App& cmd, MpiCliArgs& a);
 // True when this process runs under an MPI launcher in a build with MPI: `render` then renders

@@ -21,7 +21,7 @@ int launcher_rank();
 
 // COMM_WORLD (initialising MPI on first use when launched; one process of rank 0 otherwise).
 class Comm {
-public:
+  public:
     static Comm& world();
     int rank() const { return m_rank; }
     int size() const { return m_size; }
@@ -40,7 +40,7 @@ public:
     // waiting in a collective).
     [[noreturn]] void abort(int code);
 
-private:
+  private:
     Comm();
     int m_rank = 0, m_size = 1;
 };

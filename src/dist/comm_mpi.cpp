@@ -83,7 +83,8 @@ void Comm::recv(int from, int tag, void* data, size_t bytes) {
     } while (bytes > 0);
 }
 
-void Comm::sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* in, size_t in_bytes) {
+void Comm::sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* in,
+                    size_t in_bytes) {
     const auto* o = static_cast<const char*>(out);
     auto* i = static_cast<char*>(in);
     // Both sides walk the same number of pieces: the larger of the two sizes decides.

@@ -8,8 +8,12 @@
 
 namespace lacuna::dist {
 
-bool launched() { return false; }
-int launcher_rank() { return 0; }
+bool launched() {
+    return false;
+}
+int launcher_rank() {
+    return 0;
+}
 
 Comm::Comm() = default;
 
@@ -20,8 +24,12 @@ Comm& Comm::world() {
 
 void Comm::barrier() {}
 // One rank has no peer: a message to one is a bug of the caller.
-void Comm::send(int, int, const void*, size_t) { throw std::logic_error("dist::Comm::send: one rank"); }
-void Comm::recv(int, int, void*, size_t) { throw std::logic_error("dist::Comm::recv: one rank"); }
+void Comm::send(int, int, const void*, size_t) {
+    throw std::logic_error("dist::Comm::send: one rank");
+}
+void Comm::recv(int, int, void*, size_t) {
+    throw std::logic_error("dist::Comm::recv: one rank");
+}
 void Comm::sendrecv(int, int, const void*, size_t, void*, size_t) {
     throw std::logic_error("dist::Comm::sendrecv: one rank");
 }
@@ -29,7 +37,11 @@ std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
     const auto* p = static_cast<const uint8_t*>(mine);
     return std::vector<uint8_t>(p, p + bytes);
 }
-std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) { return gather(mine, bytes); }
-void Comm::abort(int code) { std::exit(code); }
+std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
+    return gather(mine, bytes);
+}
+void Comm::abort(int code) {
+    std::exit(code);
+}
 
 }  // namespace lacuna::dist

@@ -5,7 +5,9 @@
 
 namespace lacuna::dist {
 
-std::string to_string(Composite c) { return c == Composite::Direct ? "direct" : "binary-swap"; }
+std::string to_string(Composite c) {
+    return c == Composite::Direct ? "direct" : "binary-swap";
+}
 
 Rect nonempty_rect(const Partial& p, const Rect& within) {
     Rect r{within.x1, within.y1, within.x0, within.y0};  // inverted: empty until a pixel is found
@@ -25,8 +27,7 @@ std::vector<float> pack(const Partial& p, const Rect& r) {
     std::vector<float> out(size_t(r.pixels()) * 4);
     if (r.empty()) return out;
     const size_t row = size_t(r.x1 - r.x0) * 4;
-    for (int y = r.y0; y < r.y1; ++y)
-        std::copy_n(p.at(r.x0, y), row, &out[size_t(y - r.y0) * row]);
+    for (int y = r.y0; y < r.y1; ++y) std::copy_n(p.at(r.x0, y), row, &out[size_t(y - r.y0) * row]);
     return out;
 }
 
@@ -152,7 +153,8 @@ Partial composite_binary_swap(Comm& comm, Partial mine, const Decomposition& d, 
     // 3. Rank 0 gathers the strips.
     const Rect strip{0, r0, mine.width, r1};
     if (rank != 0) {
-        send_rect(comm, 0, kTagGather, mine, strip.empty() ? Rect{} : nonempty_rect(mine, strip), st);
+        send_rect(comm, 0, kTagGather, mine, strip.empty() ? Rect{} : nonempty_rect(mine, strip),
+                  st);
         return done(Partial{});
     }
     Partial out;

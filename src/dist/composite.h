@@ -43,7 +43,9 @@ struct Partial {
     int width = 0, height = 0;
     std::vector<float> rgba;  // 4 floats per pixel, row-major
     float* at(int x, int y) { return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
-    const float* at(int x, int y) const { return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
+    const float* at(int x, int y) const {
+        return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4];
+    }
 };
 
 // The bounding rectangle of the pixels of `within` that hold a non-zero channel.

@@ -9,7 +9,9 @@
 
 namespace lacuna::dist {
 
-std::string to_string(Balance b) { return b == Balance::Voxels ? "voxels" : "visible"; }
+std::string to_string(Balance b) {
+    return b == Balance::Voxels ? "voxels" : "visible";
+}
 
 int swap_ranks(int ranks) {
     int p = 1;
@@ -39,13 +41,17 @@ struct Builder {
         };
         int lo = box.lo[axis] + 1, hi = box.hi[axis] - 1;  // candidate planes
         if (!(total > 0)) {  // nothing to weigh: split the cells instead
-            return std::clamp(box.lo[axis] + int(std::lround(frac * (box.hi[axis] - box.lo[axis]))), lo, hi);
+            return std::clamp(box.lo[axis] + int(std::lround(frac * (box.hi[axis] - box.lo[axis]))),
+                              lo, hi);
         }
         // First plane whose low weight reaches `want`, then the closer of it and the one before.
         int a = lo, b = hi + 1;
         while (a < b) {
             const int m = a + (b - a) / 2;
-            if (low_weight(m) >= want) b = m; else a = m + 1;
+            if (low_weight(m) >= want)
+                b = m;
+            else
+                a = m + 1;
         }
         int best = std::min(a, hi);
         if (best > lo && std::abs(low_weight(best - 1) - want) <= std::abs(low_weight(best) - want))
@@ -72,8 +78,8 @@ struct Builder {
             if (box.hi[ax] - box.lo[ax] > box.hi[axis] - box.lo[axis]) axis = ax;
         if (box.hi[axis] - box.lo[axis] < 2)
             throw Error("decomposition", "ranks",
-                        "more ranks than the grid has cells to split (" + std::to_string(d.ranks()) +
-                            " ranks)");
+                        "more ranks than the grid has cells to split (" +
+                            std::to_string(d.ranks()) + " ranks)");
         const int mid = pair ? a : a + (b - a) / 2;
         const double frac = pair ? 0.5 : double(leaves(a, mid)) / double(leaves(a, b));
         const int pl = plane(box, axis, frac);

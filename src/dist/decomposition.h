@@ -44,11 +44,11 @@ std::string to_string(Balance b);
 // One node of the tree. Layout: `axis` -1 for a leaf (then `rank` is its rank), else the split
 // axis with `plane` the cell plane in whole-grid cells (children[0] holds cells < plane).
 struct KdNode {
-    CellBox box;           // the node's cells, whole grid, [lo, hi)
-    int axis = -1;         // split axis 0..2, -1: leaf
-    int plane = 0;         // split cell plane
+    CellBox box;    // the node's cells, whole grid, [lo, hi)
+    int axis = -1;  // split axis 0..2, -1: leaf
+    int plane = 0;  // split cell plane
     int children[2] = {-1, -1};
-    int rank = -1;         // leaves only
+    int rank = -1;                 // leaves only
     int slot_lo = 0, slot_hi = 0;  // the binary-swap slots [slot_lo, slot_hi) below the node
 };
 

@@ -5,9 +5,9 @@
 #include <chrono>
 #include <cstring>
 
+#include "core/parallel.h"
 #include "dist/brick_io.h"
 #include "lacuna/orientation.h"
-#include "core/parallel.h"
 #include "lacuna/session.h"
 #include "render/pixel_driver.h"
 
@@ -47,10 +47,10 @@ DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const Transfe
         const Volume whole = load();
         whole_bounds = world_bounds(whole);
         out.whole_voxels = whole.voxel_count();
-        out.decomposition = options.balance == Balance::Visible
-                                ? decompose_visible(whole, discretise(tf, whole.vis_range()),
-                                                    comm.size(), threads)
-                                : decompose_voxels(whole.dims(), comm.size());
+        out.decomposition =
+            options.balance == Balance::Visible
+                ? decompose_visible(whole, discretise(tf, whole.vis_range()), comm.size(), threads)
+                : decompose_voxels(whole.dims(), comm.size());
         own = ownership(out.decomposition, comm.rank());
         brick = crop_brick(whole, own.offset, brick_voxels(out.decomposition, comm.rank()));
     }
@@ -83,11 +83,10 @@ DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const Transfe
     const bool ortho = cam.projection() == Projection::Orthographic;
     Partial mine{f.width, f.height, std::move(r.rgba_float)};
     CompositeStats cs;
-    Partial done = options.composite == Composite::Direct
-                       ? composite_direct(comm, mine,
-                                          visibility_order(out.decomposition, eye, dir, ortho), cs)
-                       : composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir,
-                                               ortho, cs);
+    Partial done =
+        options.composite == Composite::Direct
+            ? composite_direct(comm, mine, visibility_order(out.decomposition, eye, dir, ortho), cs)
+            : composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir, ortho, cs);
     me.composite_seconds = cs.seconds;
     me.bytes_sent = cs.bytes_sent;
     if (comm.rank() == 0) {

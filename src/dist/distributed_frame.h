@@ -41,17 +41,18 @@ struct RankReport {
     double composite_seconds = 0;  // this rank's part of compositing
     double cpu_seconds = 0;        // CPU time of the render (all its threads)
     uint64_t samples = 0, rays = 0;
-    uint64_t voxels = 0;           // voxels of the brick (ghost layer included)
-    uint64_t visible_cells = 0;    // cells of the brick's box the TF can make visible (0: not counted)
-    uint64_t bytes_sent = 0;       // compositing
+    uint64_t voxels = 0;  // voxels of the brick (ghost layer included)
+    uint64_t visible_cells =
+        0;                    // cells of the brick's box the TF can make visible (0: not counted)
+    uint64_t bytes_sent = 0;  // compositing
 };
 
 struct DistFrame {
-    Image image;                     // rank 0 only
-    std::vector<RankReport> ranks;   // rank 0 only, in rank order
+    Image image;                    // rank 0 only
+    std::vector<RankReport> ranks;  // rank 0 only, in rank order
     Decomposition decomposition;
     uint64_t whole_voxels = 0;
-    double frame_seconds = 0;        // rank 0: from the render's start to the composited image
+    double frame_seconds = 0;  // rank 0: from the render's start to the composited image
 };
 
 // The whole volume once per rank, through the front end's reader.

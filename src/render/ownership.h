@@ -39,7 +39,8 @@ inline float lattice_coordinate(const kernel::IndexRay& r, int a, float t_base, 
 // over k, searched from the estimate `guess` outward one sample at a time.
 template <class Pred>
 inline int first_true(double guess, int k_end, Pred&& pred) {
-    int k = std::isfinite(guess) ? int(std::clamp(guess, 0.0, double(k_end))) : (guess > 0 ? k_end : 0);
+    int k =
+        std::isfinite(guess) ? int(std::clamp(guess, 0.0, double(k_end))) : (guess > 0 ? k_end : 0);
     while (k > 0 && pred(k - 1)) --k;
     while (k < k_end && !pred(k)) ++k;
     return k;
@@ -65,11 +66,19 @@ inline void owned_run(const kernel::IndexRay& r, float t_base, float dt, int k_e
         };
         int b, e;
         if (d[a] > 0.f) {  // p increases: [first p >= lo, first p >= hi)
-            b = std::isinf(lo[a]) ? 0 : first_true(guess(lo[a]), k_end, [&](int k) { return p(k) >= lo[a]; });
-            e = std::isinf(hi[a]) ? k_end : first_true(guess(hi[a]), k_end, [&](int k) { return p(k) >= hi[a]; });
+            b = std::isinf(lo[a])
+                    ? 0
+                    : first_true(guess(lo[a]), k_end, [&](int k) { return p(k) >= lo[a]; });
+            e = std::isinf(hi[a])
+                    ? k_end
+                    : first_true(guess(hi[a]), k_end, [&](int k) { return p(k) >= hi[a]; });
         } else {  // p decreases: [first p < hi, first p < lo)
-            b = std::isinf(hi[a]) ? 0 : first_true(guess(hi[a]), k_end, [&](int k) { return p(k) < hi[a]; });
-            e = std::isinf(lo[a]) ? k_end : first_true(guess(lo[a]), k_end, [&](int k) { return p(k) < lo[a]; });
+            b = std::isinf(hi[a])
+                    ? 0
+                    : first_true(guess(hi[a]), k_end, [&](int k) { return p(k) < hi[a]; });
+            e = std::isinf(lo[a])
+                    ? k_end
+                    : first_true(guess(lo[a]), k_end, [&](int k) { return p(k) < lo[a]; });
         }
         ka = std::max(ka, b);
         kb = std::min(kb, e);

@@ -16,9 +16,10 @@ TEST(CliMpiFlags, OutsideMpirunTheFrameIsUnchanged) {
     const std::string frame = "render " + vol + " --tf ct-soft-tissue --size 32 --quiet";
     const CliResult a = run_cli(frame + " --out " + (dir / "a.png").string(), dir);
     ASSERT_EQ(a.code, 0) << a.err;
-    const CliResult b = run_cli(frame + " --balance visible --composite binary-swap --rank-times --out " +
-                                    (dir / "b.png").string(),
-                                dir);
+    const CliResult b =
+        run_cli(frame + " --balance visible --composite binary-swap --rank-times --out " +
+                    (dir / "b.png").string(),
+                dir);
     ASSERT_EQ(b.code, 0) << b.err;
     EXPECT_EQ(slurp_file(dir / "a.png"), slurp_file(dir / "b.png"));
     EXPECT_EQ(b.out.find("ranks"), std::string::npos) << b.out;
@@ -29,11 +30,13 @@ TEST(CliMpiFlags, UnknownNamesAreOneLineErrors) {
     const std::string vol = (dir / "w.nrrd").string();
     ASSERT_EQ(run_cli("generate sphere --dims 8x8x8 --quiet --out " + vol, dir).code, 0);
     expect_one_line_error(run_cli("render " + vol + " --tf ct-bone --composite radix-2 --out " +
-                                      (dir / "x.png").string(), dir),
+                                      (dir / "x.png").string(),
+                                  dir),
                           "--composite");
-    expect_one_line_error(run_cli("render " + vol + " --tf ct-bone --balance cells --out " +
-                                      (dir / "x.png").string(), dir),
-                          "--balance");
+    expect_one_line_error(
+        run_cli("render " + vol + " --tf ct-bone --balance cells --out " + (dir / "x.png").string(),
+                dir),
+        "--balance");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 // src/dist/decomposition.h: the bricks partition the cells, balance, the binary-swap shape and
 // the visibility order.
+#include "dist/decomposition.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,7 +9,6 @@
 
 #include "accel/summed_volume_table.h"
 #include "common/rng.h"
-#include "dist/decomposition.h"
 #include "lacuna/synthetic.h"
 
 namespace lacuna::dist {
@@ -51,7 +52,8 @@ TEST(Decomposition, VisibleBalanceSplitsTheVisibleCells) {
     TransferLut lut;
     lut.vis = v.vis_range();
     lut.entries.assign(kDefaultLutSize, Rgba{});
-    for (size_t e = kDefaultLutSize / 2; e < lut.entries.size(); ++e) lut.entries[e] = {1, 1, 1, 0.5f};
+    for (size_t e = kDefaultLutSize / 2; e < lut.entries.size(); ++e)
+        lut.entries[e] = {1, 1, 1, 0.5f};
     for (int n : {2, 4, 7}) {
         const Decomposition d = decompose_visible(v, lut, n, 1);
         expect_partition(d);
@@ -70,14 +72,16 @@ TEST(Decomposition, VisibleBalanceSplitsTheVisibleCells) {
                             lo = std::min(lo, x), hi = std::max(hi, x);
                         }
                         bool vis = false;
-                        for (int e = map(lo); e <= map(hi); ++e) vis = vis || lut.entries[size_t(e)].a > 0;
+                        for (int e = map(lo); e <= map(hi); ++e)
+                            vis = vis || lut.entries[size_t(e)].a > 0;
                         c += vis;
                     }
             counts.push_back(c);
             total += c;
         }
         ASSERT_GT(total, 0);
-        for (double c : counts) EXPECT_NEAR(c, total / n, 0.2 * total / n) << n << ": " << to_string(d);
+        for (double c : counts)
+            EXPECT_NEAR(c, total / n, 0.2 * total / n) << n << ": " << to_string(d);
     }
 }
 
@@ -93,8 +97,10 @@ TEST(Decomposition, SlotNodesArePairsOfSubtrees) {
             while (!stack.empty()) {
                 const KdNode& k = d.nodes[size_t(stack.back())];
                 stack.pop_back();
-                if (k.axis < 0) out.push_back(k.rank);
-                else stack.push_back(k.children[0]), stack.push_back(k.children[1]);
+                if (k.axis < 0)
+                    out.push_back(k.rank);
+                else
+                    stack.push_back(k.children[0]), stack.push_back(k.children[1]);
             }
             std::sort(out.begin(), out.end());
             return out;
@@ -126,7 +132,8 @@ TEST(Decomposition, VisibilityOrderFollowsEveryRay) {
         const Decomposition d = decompose_voxels({30, 25, 20}, n);
         for (int it = 0; it < 50; ++it) {
             const bool ortho = it % 3 == 0;
-            const Vec3f eye{-20.f + 70.f * rng.uniform(), -20.f + 65.f * rng.uniform(), -20.f + 60.f * rng.uniform()};
+            const Vec3f eye{-20.f + 70.f * rng.uniform(), -20.f + 65.f * rng.uniform(),
+                            -20.f + 60.f * rng.uniform()};
             Vec3f dir{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f};
             const std::vector<int> order = visibility_order(d, eye, dir, ortho);
             std::vector<int> pos(static_cast<size_t>(n));
@@ -136,9 +143,11 @@ TEST(Decomposition, VisibilityOrderFollowsEveryRay) {
                 Vec3f o = eye, dd;
                 if (ortho) {
                     dd = dir;
-                    o = {eye.x + 10.f * (rng.uniform() - 0.5f), eye.y + 10.f * (rng.uniform() - 0.5f), eye.z};
+                    o = {eye.x + 10.f * (rng.uniform() - 0.5f),
+                         eye.y + 10.f * (rng.uniform() - 0.5f), eye.z};
                 } else {
-                    const Vec3f target{30.f * rng.uniform(), 25.f * rng.uniform(), 20.f * rng.uniform()};
+                    const Vec3f target{30.f * rng.uniform(), 25.f * rng.uniform(),
+                                       20.f * rng.uniform()};
                     dd = target - eye;
                 }
                 int last = -1;

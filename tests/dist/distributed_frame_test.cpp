@@ -31,8 +31,8 @@ struct Bricked {
 };
 
 // The frame from `n` brick sessions composited front to back on the pixels' float RGBA.
-Bricked render_bricked(const Volume& whole, const TransferFunction& tf, const FrameSpec& spec, int n,
-                       Balance balance) {
+Bricked render_bricked(const Volume& whole, const TransferFunction& tf, const FrameSpec& spec,
+                       int n, Balance balance) {
     const Decomposition d = balance == Balance::Voxels
                                 ? decompose_voxels(whole.dims(), n)
                                 : decompose_visible(whole, discretise(tf, whole.vis_range()), n, 1);
@@ -58,7 +58,8 @@ Bricked render_bricked(const Volume& whole, const TransferFunction& tf, const Fr
         eye = cam.eye() * inv, dir = cam.forward() * inv;
         ortho = cam.projection() == Projection::Orthographic;
     }
-    Partial acc{spec.width, spec.height, std::vector<float>(size_t(spec.width) * spec.height * 4, 0.f)};
+    Partial acc{spec.width, spec.height,
+                std::vector<float>(size_t(spec.width) * spec.height * 4, 0.f)};
     const Rect whole_rect{0, 0, spec.width, spec.height};
     for (int r : visibility_order(d, eye, dir, ortho)) {
         const Rect rect = nonempty_rect(parts[size_t(r)], whole_rect);
@@ -89,7 +90,8 @@ void expect_close(const Image& a, const Image& b, const std::string& what) {
         differ += d;
     }
     EXPECT_LE(worst, 1u) << what;
-    EXPECT_LE(double(differ), 0.01 * double(a.rgba.size() / 4)) << what << ": " << differ << " pixels differ";
+    EXPECT_LE(double(differ), 0.01 * double(a.rgba.size() / 4))
+        << what << ": " << differ << " pixels differ";
 }
 
 struct Case {
@@ -103,12 +105,9 @@ TEST(DistributedFrame, BricksTakeEverySampleOnceAndMatchOneProcess) {
     o.threads = 1;
     const Volume whole = generate(SyntheticKind::SphereShells, o);
     const TransferFunction tf = test_tf();
-    const Case cases[] = {{"none", structure::None{}},
-                          {"grid", structure::Grid{}},
-                          {"bitfield", structure::Bitfield{}},
-                          {"kdtree", structure::KdTree{}},
-                          {"minmax", structure::MinMax{}},
-                          {"distance", structure::Distance{}}};
+    const Case cases[] = {{"none", structure::None{}},         {"grid", structure::Grid{}},
+                          {"bitfield", structure::Bitfield{}}, {"kdtree", structure::KdTree{}},
+                          {"minmax", structure::MinMax{}},     {"distance", structure::Distance{}}};
     Session single(Volume(whole), 1);
     single.set_transfer_function(tf);
     int view = 0;
@@ -120,18 +119,25 @@ TEST(DistributedFrame, BricksTakeEverySampleOnceAndMatchOneProcess) {
             spec.sampling.early_termination = std::nullopt;
             spec.camera.orbit.azimuth_deg = 37.f * float(view);
             spec.camera.orbit.elevation_deg = -50.f + 23.f * float(view % 5);
-            spec.camera.orbit.projection = view % 3 == 2 ? Projection::Orthographic : Projection::Perspective;
-            if (view % 4 == 3) spec.camera.orbit.zoom = 3.f;  // the eye close, rays from inside
+            spec.camera.orbit.projection =
+                view % 3 == 2 ? Projection::Orthographic : Projection::Perspective;
+            if (view % 4 == 3) {  // the eye inside the volume
+                spec.camera.orbit.has_target = true;
+                spec.camera.orbit.target = {15.f, 12.f, 22.f};
+                spec.camera.orbit.distance = 4.f;
+                spec.camera.orbit.fov_y_deg = 70.f;
+            }
             ++view;
             spec.count_samples = true;
             const FrameResult ref = single.render(spec);
-            const Bricked b = render_bricked(whole, tf, spec, n,
-                                             n % 2 ? Balance::Voxels : Balance::Visible);
+            const Bricked b =
+                render_bricked(whole, tf, spec, n, n % 2 ? Balance::Voxels : Balance::Visible);
             const std::string what = std::string(c.name) + " ranks " + std::to_string(n);
             expect_close(b.image, ref.image, what);
             if (std::holds_alternative<structure::None>(c.structure))
                 EXPECT_EQ(b.counts, ref.sample_counts) << what << ": every lattice sample once";
-            if (n == 1) EXPECT_EQ(b.image.rgba, ref.image.rgba) << what << ": one brick is the frame";
+            if (n == 1)
+                EXPECT_EQ(b.image.rgba, ref.image.rgba) << what << ": one brick is the frame";
         }
     }
 }

@@ -1,16 +1,18 @@
 // render/ownership.h: the owned run of a ray equals the brute-force set of lattice samples whose
 // kernel position lies in the box, and bricks that partition space take every sample once.
+#include "render/ownership.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "common/rng.h"
-#include "render/ownership.h"
 
 namespace lacuna {
 namespace {
 
-bool in_box(const kernel::IndexRay& r, float t_base, float dt, int k, const float lo[3], const float hi[3]) {
+bool in_box(const kernel::IndexRay& r, float t_base, float dt, int k, const float lo[3],
+            const float hi[3]) {
     for (int a = 0; a < 3; ++a) {
         const float p = lattice_coordinate(r, a, t_base, dt, k);
         if (!(p >= lo[a] && p < hi[a])) return false;
@@ -21,7 +23,8 @@ bool in_box(const kernel::IndexRay& r, float t_base, float dt, int k, const floa
 kernel::IndexRay random_ray(test::Rng& rng) {
     kernel::IndexRay r{};
     float* o = &r.ox;
-    for (int a = 0; a < 6; ++a) o[a] = a < 3 ? -20.f + 60.f * rng.uniform() : -1.f + 2.f * rng.uniform();
+    for (int a = 0; a < 6; ++a)
+        o[a] = a < 3 ? -20.f + 60.f * rng.uniform() : -1.f + 2.f * rng.uniform();
     if (rng.coin(4)) r.dy = 0.f;  // axis-parallel components
     if (rng.coin(8)) r.dx = -0.f;
     return r;
@@ -56,7 +59,8 @@ TEST(Ownership, BricksAroundPlanesTakeEverySampleOnce) {
         if (it % 5 == 0) r = {0.f, 0.5f, 0.25f, 1.f, 0.f, 0.f};  // samples on planes x = integer
         const float t_base = 2.f * rng.uniform(), dt = it % 5 == 0 ? 0.5f : 0.1f + rng.uniform();
         const int k_end = 200;
-        const float plane[3] = {float(rng.range(1, 20)), float(rng.range(1, 20)), float(rng.range(1, 20))};
+        const float plane[3] = {float(rng.range(1, 20)), float(rng.range(1, 20)),
+                                float(rng.range(1, 20))};
         std::vector<int> taken(size_t(k_end), 0);
         for (int b = 0; b < 8; ++b) {
             float lo[3], hi[3];

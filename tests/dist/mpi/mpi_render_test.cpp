@@ -54,7 +54,8 @@ size_t expect_close(const fs::path& a, const fs::path& b, const std::string& wha
         differ += d;
     }
     EXPECT_LE(worst, 1) << what;
-    EXPECT_LE(double(differ), 0.01 * double(x.rgba.size() / 4)) << what << ": " << differ << " pixels differ";
+    EXPECT_LE(double(differ), 0.01 * double(x.rgba.size() / 4))
+        << what << ": " << differ << " pixels differ";
     return differ;
 }
 
@@ -63,7 +64,8 @@ size_t expect_close(const fs::path& a, const fs::path& b, const std::string& wha
 const fs::path& shells_volume() {
     static const fs::path v = [] {
         const fs::path p = dir() / "shells.nrrd";
-        const CliResult r = run_cli("generate sphere-shells --dims 45x38x52 --out " + p.string() + " --quiet", dir());
+        const CliResult r = run_cli(
+            "generate sphere-shells --dims 45x38x52 --out " + p.string() + " --quiet", dir());
         EXPECT_EQ(r.code, 0) << r.err;
         return p;
     }();
@@ -74,7 +76,8 @@ const fs::path& shells_volume() {
 void check_frames(const std::string& volume, const std::string& frame, const std::string& tag,
                   const std::vector<int>& ranks, const std::vector<std::string>& composites) {
     const fs::path ref = dir() / (tag + "_ref.png");
-    const CliResult r = run_cli("render " + volume + " " + frame + " --ert 1 --quiet --out " + ref.string(), dir());
+    const CliResult r =
+        run_cli("render " + volume + " " + frame + " --ert 1 --quiet --out " + ref.string(), dir());
     ASSERT_EQ(r.code, 0) << r.err;
     for (int n : ranks)
         for (const std::string& c : composites) {
@@ -101,10 +104,12 @@ TEST(MpiRender, GridBitfieldKdtreeMatchOneProcess) {
 }
 
 TEST(MpiRender, VisibleBalanceOrthographicAndInside) {
-    check_frames(shells_volume().string(), std::string(kFrame) + " --ortho --balance visible", "ortho",
-                 {3, 4}, {"direct", "binary-swap"});
-    check_frames(shells_volume().string(), "--tf mr-default --size 48 --zoom 3.5 --accel grid",
-                 "inside", {2, 7}, {"binary-swap"});
+    check_frames(shells_volume().string(), std::string(kFrame) + " --ortho --balance visible",
+                 "ortho", {3, 4}, {"direct", "binary-swap"});
+    check_frames(
+        shells_volume().string(),
+        "--tf mr-default --size 48 --azimuth 0 --elevation 0 --zoom 12 --fov 60 --accel grid",
+        "inside", {2, 7}, {"binary-swap"});
 }
 
 TEST(MpiRender, Ch2HeadMatchesOneProcess) {
@@ -133,7 +138,9 @@ TEST(MpiRender, RefusedFramesAreOneLineFromRankZero) {
                                            flags + " --out " + (dir() / "refused.png").string());
         EXPECT_NE(m.code, 0) << flags;
         size_t lines = 0;
-        for (size_t p = m.err.find("lacuna:"); p != std::string::npos; p = m.err.find("lacuna:", p + 1)) ++lines;
+        for (size_t p = m.err.find("lacuna:"); p != std::string::npos;
+             p = m.err.find("lacuna:", p + 1))
+            ++lines;
         EXPECT_EQ(lines, 1u) << flags << ": " << m.err;
         EXPECT_FALSE(fs::exists(dir() / "refused.png"));
     }
