@@ -481,12 +481,11 @@ void render_frames(RenderArgs& a, const Setup& s) {
         case Renderer::RayMarcher:
             if (mpi_render_active()) {
                 // Under mpirun: one frame by every rank (render_mpi.h).
-                if (a.orbit || !a.tf_animate.empty() || a.repeat != 1 || !a.heatmap.empty() ||
-                    !a.movie.empty())
+                if (a.orbit || !a.tf_animate.empty() || a.repeat != 1 || !a.movie.empty())
                     throw Error("mpirun", "frames",
                                 "one frame per run under mpirun (not --orbit, --tf-animate, "
-                                "--repeat, --heatmap or --movie yet)");
-                render_mpi({a.volume, front_tf(a), accel, a.out, a.threads, s.spec, a.mpi});
+                                "--repeat or --movie yet)");
+                render_mpi({a.volume, front_tf(a), accel, a.out, a.heatmap, a.threads, s.spec, a.mpi});
                 return;
             }
             if (a.orbit)

@@ -70,6 +70,8 @@ void render_mpi(const MpiRenderJob& job) {
     }
     if (comm.rank() != 0) return;
     write_png(job.out, f.image);
+    if (!job.heatmap.empty())
+        write_png(job.heatmap, heatmap(f.sample_counts, job.spec.width, job.spec.height));
     const FrameSpec& s = job.spec;
     uint64_t samples = 0, rays = 0, voxels = 0, bytes = 0;
     double slowest = 0;
@@ -103,6 +105,7 @@ void render_mpi(const MpiRenderJob& job) {
                         100.0 * double(r.voxels) / double(std::max<uint64_t>(f.whole_voxels, 1)),
                         double(r.bytes_sent) / 1024);
     }
+    if (!job.heatmap.empty()) std::printf("wrote %s\n", job.heatmap.c_str());
     std::printf("wrote %s\n", job.out.c_str());
     std::fflush(stdout);
 }

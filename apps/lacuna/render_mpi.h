@@ -25,6 +25,7 @@ struct MpiRenderJob {
     VolumeArgs volume;
     TransferFunction tf;
     std::string accel, out;  // accel: the --accel name, for the report
+    std::string heatmap;     // --heatmap: every rank's samples per pixel, summed
     int threads = 0;
     FrameSpec spec;
     MpiCliArgs mpi;

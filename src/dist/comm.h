@@ -34,6 +34,9 @@ class Comm {
     void sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* in, size_t in_bytes);
     // Every rank's `mine` (the same size everywhere) on rank 0, in rank order.
     std::vector<uint8_t> gather(const void* mine, size_t bytes);
+    // The element-wise sum of every rank's `v` (the same length everywhere) into rank 0's `v`
+    // (the other ranks' are left as they were).
+    void sum_to_root(std::vector<uint32_t>& v);
     // Every rank's `mine` on every rank, in rank order.
     std::vector<uint8_t> allgather(const void* mine, size_t bytes);
     // Ends every rank of the job with this exit code (after a rank's error: the others may be

@@ -105,6 +105,15 @@ std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
     return all;
 }
 
+void Comm::sum_to_root(std::vector<uint32_t>& v) {
+    if (m_size == 1) return;
+    if (v.size() > size_t(INT_MAX)) throw Error("mpi", "reduce", "expected under 2^31 counts");
+    if (m_rank == 0)
+        MPI_Reduce(MPI_IN_PLACE, v.data(), int(v.size()), MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
+    else
+        MPI_Reduce(v.data(), nullptr, int(v.size()), MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
+}
+
 std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     if (bytes > size_t(INT_MAX)) throw Error("mpi", "allgather", "expected under 2 GiB per rank");
     std::vector<uint8_t> all(bytes * size_t(m_size));

@@ -37,6 +37,7 @@ std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
     const auto* p = static_cast<const uint8_t*>(mine);
     return std::vector<uint8_t>(p, p + bytes);
 }
+void Comm::sum_to_root(std::vector<uint32_t>&) {}
 std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     return gather(mine, bytes);
 }

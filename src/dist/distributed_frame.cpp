@@ -62,7 +62,6 @@ DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const Transfe
     session.set_transfer_function(tf);
     FrameSpec f = spec;
     f.keep_float = true;
-    f.count_samples = false;
     t0 = Clock::now();
     session.prepare(f);
     session.refine();
@@ -87,6 +86,10 @@ DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const Transfe
         options.composite == Composite::Direct
             ? composite_direct(comm, mine, visibility_order(out.decomposition, eye, dir, ortho), cs)
             : composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir, ortho, cs);
+    if (f.count_samples) {
+        comm.sum_to_root(r.sample_counts);
+        if (comm.rank() == 0) out.sample_counts = std::move(r.sample_counts);
+    }
     me.composite_seconds = cs.seconds;
     me.bytes_sent = cs.bytes_sent;
     if (comm.rank() == 0) {

@@ -49,6 +49,9 @@ struct RankReport {
 
 struct DistFrame {
     Image image;                    // rank 0 only
+    // Per pixel, the samples of every rank summed (rank 0, when the spec's count_samples): the
+    // single-process counts of --accel none exactly (every lattice sample once).
+    std::vector<uint32_t> sample_counts;
     std::vector<RankReport> ranks;  // rank 0 only, in rank order
     Decomposition decomposition;
     uint64_t whole_voxels = 0;

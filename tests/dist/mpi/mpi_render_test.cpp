@@ -132,6 +132,23 @@ TEST(MpiRender, OnlyRankZeroWritesAndReports) {
         EXPECT_NE(m.out.find("\n   " + std::to_string(r) + " "), std::string::npos) << m.out;
 }
 
+// Every lattice sample once: the per-pixel counts summed over the ranks are the one-process
+// counts of --accel none, so the heat maps are the same bytes.
+TEST(MpiRender, HeatmapOfNoneIsTheOneProcessHeatmap) {
+    const std::string frame = "render " + shells_volume().string() + " " + kFrame + " --accel none";
+    const CliResult r = run_cli(frame + " --ert 1 --quiet --out " + (dir() / "h_ref.png").string() +
+                                    " --heatmap " + (dir() / "h_ref_heat.png").string(),
+                                dir());
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int n : {3, 4}) {
+        const fs::path heat = dir() / ("h_" + std::to_string(n) + "_heat.png");
+        const CliResult m = run_mpi(n, frame + " --out " + (dir() / "h.png").string() +
+                                           " --heatmap " + heat.string());
+        ASSERT_EQ(m.code, 0) << m.err;
+        EXPECT_EQ(slurp_file(heat), slurp_file(dir() / "h_ref_heat.png")) << n << " ranks";
+    }
+}
+
 TEST(MpiRender, RefusedFramesAreOneLineFromRankZero) {
     for (const char* flags : {"--shading phong", "--orbit 3", "--renderer slice"}) {
         const CliResult m = run_mpi(2, "render " + shells_volume().string() + " " + kFrame + " " +
