@@ -57,10 +57,18 @@ void render_mpi(const MpiRenderJob& job) {
         throw Error("mpirun", "features",
                     "distributed rendering takes no features yet (shading, gradient opacity, "
                     "shadows, clip planes, crop, blend modes, jitter, --tf-back)");
+    // Raw files are read by offset (each rank its brick), every other file whole by each rank.
+    dist::VolumeSource source;
+    source.load_whole = [&] { return load_volume(job.volume); };
+    source.raw = dist::raw_brick_file(job.volume.path, job.volume.raw_spec ? job.volume.raw_spec
+                                                                           : raw_spec_of(job.volume));
+    if (job.volume.range_value)
+        source.vis_range = job.volume.range_value;
+    else if (!job.volume.range.empty())
+        source.vis_range = parse_range(job.volume.range);
     dist::DistFrame f;
     try {
-        f = dist::render_distributed(
-            comm, [&] { return load_volume(job.volume); }, job.tf, job.spec, o, job.threads);
+        f = dist::render_distributed(comm, source, job.tf, job.spec, o, job.threads);
     } catch (const Error& e) {
         // A rank's own failure (its brick, its memory): the others may wait in a collective,
         // so the job ends here with the CLI's exit code for errors.
@@ -95,14 +103,16 @@ void render_mpi(const MpiRenderJob& job) {
         f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
         double(bytes) / (1 << 20));
     if (job.mpi.rank_times) {
-        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %10s\n", "rank", "load ms", "build ms",
-                    "render ms", "composite ms", "CPU ms", "samples", "voxels%", "sent KiB");
+        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %8s %10s\n", "rank", "load ms",
+                    "build ms", "render ms", "composite ms", "CPU ms", "samples", "voxels%",
+                    "read%", "sent KiB");
         for (const auto& r : f.ranks)
-            std::printf("%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %10.1f\n", r.rank,
+            std::printf("%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %8.1f %10.1f\n", r.rank,
                         r.load_seconds * 1e3, r.build_seconds * 1e3, r.render_seconds * 1e3,
                         r.composite_seconds * 1e3, r.cpu_seconds * 1e3,
                         (unsigned long long)r.samples,
                         100.0 * double(r.voxels) / double(std::max<uint64_t>(f.whole_voxels, 1)),
+                        100.0 * double(r.voxels_read) / double(std::max<uint64_t>(f.whole_voxels, 1)),
                         double(r.bytes_sent) / 1024);
     }
     if (!job.heatmap.empty()) std::printf("wrote %s\n", job.heatmap.c_str());

@@ -37,6 +37,8 @@ class Comm {
     // The element-wise sum of every rank's `v` (the same length everywhere) into rank 0's `v`
     // (the other ranks' are left as they were).
     void sum_to_root(std::vector<uint32_t>& v);
+    // The smallest `lo` and the largest `hi` over every rank, on every rank.
+    void minmax(float& lo, float& hi);
     // Every rank's `mine` on every rank, in rank order.
     std::vector<uint8_t> allgather(const void* mine, size_t bytes);
     // Ends every rank of the job with this exit code (after a rank's error: the others may be

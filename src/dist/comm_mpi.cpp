@@ -114,6 +114,12 @@ void Comm::sum_to_root(std::vector<uint32_t>& v) {
         MPI_Reduce(v.data(), nullptr, int(v.size()), MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
 }
 
+void Comm::minmax(float& lo, float& hi) {
+    if (m_size == 1) return;
+    MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_FLOAT, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD);
+}
+
 std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     if (bytes > size_t(INT_MAX)) throw Error("mpi", "allgather", "expected under 2 GiB per rank");
     std::vector<uint8_t> all(bytes * size_t(m_size));

@@ -38,6 +38,7 @@ std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
     return std::vector<uint8_t>(p, p + bytes);
 }
 void Comm::sum_to_root(std::vector<uint32_t>&) {}
+void Comm::minmax(float&, float&) {}
 std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     return gather(mine, bytes);
 }

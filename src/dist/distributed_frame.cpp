@@ -32,7 +32,7 @@ int rank_threads(int requested) {
     return resolve_threads(0);
 }
 
-DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const TransferFunction& tf,
+DistFrame render_distributed(Comm& comm, const VolumeSource& source, const TransferFunction& tf,
                              const FrameSpec& spec, const DistOptions& options, int threads) {
     threads = rank_threads(threads);
     DistFrame out;
@@ -43,14 +43,28 @@ DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const Transfe
     Box3f whole_bounds;
     Volume brick;
     BrickOwnership own;
-    {
-        const Volume whole = load();
+    if (source.raw && options.balance == Balance::Voxels) {
+        // By offset: the header alone gives the grid; each rank reads its brick, then all agree
+        // on the whole volume's range from their bricks' (which cover every voxel).
+        const Volume header = header_of(*source.raw);
+        whole_bounds = world_bounds(header);
+        out.whole_voxels = header.voxel_count();
+        out.decomposition = decompose_voxels(header.dims(), comm.size());
+        own = ownership(out.decomposition, comm.rank());
+        brick = read_brick(*source.raw, own.offset, brick_voxels(out.decomposition, comm.rank()));
+        me.voxels_read = brick.voxel_count();
+        float lo = brick.data_range().min, hi = brick.data_range().max;
+        comm.minmax(lo, hi);
+        brick.set_vis_range(source.vis_range ? *source.vis_range : default_vis_range(lo, hi));
+    } else {
+        const Volume whole = source.load_whole();
         whole_bounds = world_bounds(whole);
         out.whole_voxels = whole.voxel_count();
-        out.decomposition =
-            options.balance == Balance::Visible
-                ? decompose_visible(whole, discretise(tf, whole.vis_range()), comm.size(), threads)
-                : decompose_voxels(whole.dims(), comm.size());
+        me.voxels_read = whole.voxel_count();
+        out.decomposition = options.balance == Balance::Visible
+                                ? decompose_visible(whole, discretise(tf, whole.vis_range()),
+                                                    comm.size(), threads)
+                                : decompose_voxels(whole.dims(), comm.size());
         own = ownership(out.decomposition, comm.rank());
         brick = crop_brick(whole, own.offset, brick_voxels(out.decomposition, comm.rank()));
     }

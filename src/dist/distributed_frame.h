@@ -15,6 +15,9 @@
 #include <functional>
 #include <vector>
 
+#include <optional>
+
+#include "dist/brick_io.h"
 #include "dist/comm.h"
 #include "dist/composite.h"
 #include "dist/decomposition.h"
@@ -42,6 +45,7 @@ struct RankReport {
     double cpu_seconds = 0;        // CPU time of the render (all its threads)
     uint64_t samples = 0, rays = 0;
     uint64_t voxels = 0;  // voxels of the brick (ghost layer included)
+    uint64_t voxels_read = 0;  // voxels read from the file (the brick's, or the whole file's)
     uint64_t visible_cells =
         0;                    // cells of the brick's box the TF can make visible (0: not counted)
     uint64_t bytes_sent = 0;  // compositing
@@ -61,12 +65,19 @@ struct DistFrame {
 // The whole volume once per rank, through the front end's reader.
 using VolumeLoader = std::function<Volume()>;
 
+// Where the ranks' voxels come from (brick_io.h).
+struct VolumeSource {
+    VolumeLoader load_whole;            // any file: read whole by every rank, the brick cut out
+    std::optional<RawBrickFile> raw;    // set: bricks read by offset (with Balance::Voxels)
+    std::optional<ValueRange> vis_range;  // the front end's visualization range (--range), if any
+};
+
 // Worker threads of a rank: `requested`, or for 0 the cores this process may run on (its CPU
 // affinity, which mpirun sets when it binds ranks to cores).
 int rank_threads(int requested);
 
 // `threads` as rank_threads() resolves it.
-DistFrame render_distributed(Comm& comm, const VolumeLoader& load, const TransferFunction& tf,
+DistFrame render_distributed(Comm& comm, const VolumeSource& source, const TransferFunction& tf,
                              const FrameSpec& spec, const DistOptions& options, int threads);
 
 }  // namespace lacuna::dist

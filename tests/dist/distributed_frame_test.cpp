@@ -134,10 +134,12 @@ TEST(DistributedFrame, BricksTakeEverySampleOnceAndMatchOneProcess) {
                 render_bricked(whole, tf, spec, n, n % 2 ? Balance::Voxels : Balance::Visible);
             const std::string what = std::string(c.name) + " ranks " + std::to_string(n);
             expect_close(b.image, ref.image, what);
-            if (std::holds_alternative<structure::None>(c.structure))
+            if (std::holds_alternative<structure::None>(c.structure)) {
                 EXPECT_EQ(b.counts, ref.sample_counts) << what << ": every lattice sample once";
-            if (n == 1)
+            }
+            if (n == 1) {
                 EXPECT_EQ(b.image.rgba, ref.image.rgba) << what << ": one brick is the frame";
+            }
         }
     }
 }

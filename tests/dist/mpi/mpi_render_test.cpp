@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "apps/cli_run.h"
@@ -130,6 +131,33 @@ TEST(MpiRender, OnlyRankZeroWritesAndReports) {
     EXPECT_NE(m.out.find("early ray termination: off"), std::string::npos) << m.out;
     for (int r = 0; r < 3; ++r)
         EXPECT_NE(m.out.find("\n   " + std::to_string(r) + " "), std::string::npos) << m.out;
+}
+
+// A raw file is read by offset: each rank reads its brick (the read% column of --rank-times),
+// and the frame is the one-process frame, the visualization range agreed from the bricks'.
+TEST(MpiRender, RawBricksAreReadByOffset) {
+    const fs::path raw = dir() / "shells_45x38x52_uint8.raw";
+    ASSERT_EQ(run_cli("generate sphere-shells --dims 45x38x52 --out " + raw.string() + " --quiet", dir()).code, 0);
+    for (int n : {2, 4}) {
+        check_frames(raw.string(), std::string(kFrame) + " --accel bitfield", "raw" + std::to_string(n), {n},
+                     {"direct"});
+        const CliResult m = run_mpi(n, "render " + raw.string() + " " + kFrame + " --rank-times --out " +
+                                           (dir() / "raw.png").string());
+        ASSERT_EQ(m.code, 0) << m.err;
+        int rows = 0;
+        for (size_t p = m.out.find("\n"); p != std::string::npos; p = m.out.find("\n", p + 1)) {
+            int rank;
+            double f[7], voxels, read;
+            unsigned long long samples;
+            if (std::sscanf(m.out.c_str() + p + 1, "%d %lf %lf %lf %lf %lf %llu %lf %lf", &rank, &f[0], &f[1],
+                            &f[2], &f[3], &f[4], &samples, &voxels, &read) == 9) {
+                ++rows;
+                EXPECT_EQ(read, voxels) << m.out;  // the brick, not the file
+                EXPECT_LT(read, 100.0 / n + 10.0) << m.out;
+            }
+        }
+        EXPECT_EQ(rows, n) << m.out;
+    }
 }
 
 // Every lattice sample once: the per-pixel counts summed over the ranks are the one-process
