@@ -21,7 +21,9 @@ dist::Balance parse_balance(const std::string& s) {
 dist::Composite parse_composite(const std::string& s) {
     if (s == "direct") return dist::Composite::Direct;
     if (s == "binary-swap") return dist::Composite::BinarySwap;
-    throw Error("--composite", "compositing", "expected direct or binary-swap, got '" + s + "'");
+    if (s == "radix-k") return dist::Composite::RadixK;
+    throw Error("--composite", "compositing",
+                "expected direct, binary-swap or radix-k, got '" + s + "'");
 }
 
 }  // namespace
@@ -31,8 +33,10 @@ void add_mpi_options(CLI::App& cmd, MpiCliArgs& a) {
                    "Under mpirun: kd-tree bricks balanced on voxels, or on the cells the TF can "
                    "make visible (docs/distributed.md)")
         ->capture_default_str();
-    cmd.add_option("--composite", a.composite,
-                   "Under mpirun: sort-last compositing, direct (to rank 0) or binary-swap")
+    cmd.add_option(
+           "--composite", a.composite,
+           "Under mpirun: sort-last compositing, direct (to rank 0), binary-swap or radix-k "
+           "(k = 4)")
         ->capture_default_str();
     cmd.add_flag("--rank-times", a.rank_times,
                  "Under mpirun: rank 0 prints each rank's load, build, render and composite times");
@@ -60,8 +64,8 @@ void render_mpi(const MpiRenderJob& job) {
     // Raw files are read by offset (each rank its brick), every other file whole by each rank.
     dist::VolumeSource source;
     source.load_whole = [&] { return load_volume(job.volume); };
-    source.raw = dist::raw_brick_file(job.volume.path, job.volume.raw_spec ? job.volume.raw_spec
-                                                                           : raw_spec_of(job.volume));
+    source.raw = dist::raw_brick_file(
+        job.volume.path, job.volume.raw_spec ? job.volume.raw_spec : raw_spec_of(job.volume));
     if (job.volume.range_value)
         source.vis_range = job.volume.range_value;
     else if (!job.volume.range.empty())
@@ -103,17 +107,17 @@ void render_mpi(const MpiRenderJob& job) {
         f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
         double(bytes) / (1 << 20));
     if (job.mpi.rank_times) {
-        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %8s %10s\n", "rank", "load ms",
-                    "build ms", "render ms", "composite ms", "CPU ms", "samples", "voxels%",
-                    "read%", "sent KiB");
+        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %8s %10s\n", "rank", "load ms", "build ms",
+                    "render ms", "composite ms", "CPU ms", "samples", "voxels%", "read%",
+                    "sent KiB");
         for (const auto& r : f.ranks)
-            std::printf("%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %8.1f %10.1f\n", r.rank,
-                        r.load_seconds * 1e3, r.build_seconds * 1e3, r.render_seconds * 1e3,
-                        r.composite_seconds * 1e3, r.cpu_seconds * 1e3,
-                        (unsigned long long)r.samples,
-                        100.0 * double(r.voxels) / double(std::max<uint64_t>(f.whole_voxels, 1)),
-                        100.0 * double(r.voxels_read) / double(std::max<uint64_t>(f.whole_voxels, 1)),
-                        double(r.bytes_sent) / 1024);
+            std::printf(
+                "%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %8.1f %10.1f\n", r.rank,
+                r.load_seconds * 1e3, r.build_seconds * 1e3, r.render_seconds * 1e3,
+                r.composite_seconds * 1e3, r.cpu_seconds * 1e3, (unsigned long long)r.samples,
+                100.0 * double(r.voxels) / double(std::max<uint64_t>(f.whole_voxels, 1)),
+                100.0 * double(r.voxels_read) / double(std::max<uint64_t>(f.whole_voxels, 1)),
+                double(r.bytes_sent) / 1024);
     }
     if (!job.heatmap.empty()) std::printf("wrote %s\n", job.heatmap.c_str());
     std::printf("wrote %s\n", job.out.c_str());

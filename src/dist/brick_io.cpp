@@ -48,7 +48,8 @@ bool host_little_endian() {
 }
 }  // namespace
 
-std::optional<RawBrickFile> raw_brick_file(const std::string& path, const std::optional<RawSpec>& raw) {
+std::optional<RawBrickFile> raw_brick_file(const std::string& path,
+                                           const std::optional<RawSpec>& raw) {
     const std::filesystem::path p(path);
     std::string ext = p.extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -91,10 +92,11 @@ Volume read_brick(const RawBrickFile& f, Vec3i offset, Vec3i dims) {
     for (int k = 0; k < dims.z; ++k)
         for (int j = 0; j < dims.y; ++j) {
             // One row of the brick: voxels offset.x .. offset.x + dims.x - 1 of file row (y, z).
-            const uint64_t at = ((uint64_t(offset.z + k) * uint64_t(wd.y) + uint64_t(offset.y + j)) *
-                                     uint64_t(wd.x) +
-                                 uint64_t(offset.x)) *
-                                vs;
+            const uint64_t at =
+                ((uint64_t(offset.z + k) * uint64_t(wd.y) + uint64_t(offset.y + j)) *
+                     uint64_t(wd.x) +
+                 uint64_t(offset.x)) *
+                vs;
             in.seekg(std::streamoff(at));
             in.read(dst + b.index(0, j, k) * vs, row);
             if (in.gcount() != row) throw Error(f.path, "voxel data", "read error or truncated");

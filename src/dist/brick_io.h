@@ -32,7 +32,8 @@ struct RawBrickFile {
 // `path` as such a file: a .raw name with a layout (`raw`, else the name's), integer voxels in
 // the host's byte order, of exactly the layout's size (lacuna::Error otherwise, as read_volume
 // says it). nullopt: another format, float voxels or the other byte order (read whole).
-std::optional<RawBrickFile> raw_brick_file(const std::string& path, const std::optional<RawSpec>& raw);
+std::optional<RawBrickFile> raw_brick_file(const std::string& path,
+                                           const std::optional<RawSpec>& raw);
 // The whole volume's header alone: dims, type and geometry, no voxels (Volume's adopting
 // constructor with no buffer): what world_bounds and the decomposition need.
 Volume header_of(const RawBrickFile& f);

@@ -6,7 +6,15 @@
 namespace lacuna::dist {
 
 std::string to_string(Composite c) {
-    return c == Composite::Direct ? "direct" : "binary-swap";
+    switch (c) {
+        case Composite::Direct:
+            return "direct";
+        case Composite::BinarySwap:
+            return "binary-swap";
+        case Composite::RadixK:
+            return "radix-k";
+    }
+    return "?";
 }
 
 Rect nonempty_rect(const Partial& p, const Rect& within) {
@@ -165,6 +173,104 @@ Partial composite_binary_swap(Comm& comm, Partial mine, const Decomposition& d, 
     for (int q = 1; q < p; ++q) {
         const Rect r = recv_rect(comm, q, kTagGather, px);
         composite_into(out, r, px.data(), true);  // over zero: a copy
+    }
+    return done(std::move(out));
+}
+
+std::vector<int> block_order(const Decomposition& d, int a, int b, int unit, Vec3f eye, Vec3f dir,
+                             bool orthographic) {
+    if (b - a <= unit) return {a / unit};
+    const KdNode& n = d.nodes[size_t(slot_node(d, a, b))];
+    const int mid = a + (b - a) / 2;
+    std::vector<int> lo = block_order(d, a, mid, unit, eye, dir, orthographic);
+    std::vector<int> hi = block_order(d, mid, b, unit, eye, dir, orthographic);
+    if (!low_in_front(n, eye, dir, orthographic)) std::swap(lo, hi);
+    lo.insert(lo.end(), hi.begin(), hi.end());
+    return lo;
+}
+
+Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3f eye, Vec3f dir,
+                          bool orthographic, int k, CompositeStats& st) {
+    const auto t0 = Clock::now();
+    const int n = comm.size(), rank = comm.rank();
+    const int p = swap_ranks(n), extras = n - p;
+    auto done = [&](Partial result) {
+        st.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+        return result;
+    };
+    const Rect whole{0, 0, mine.width, mine.height};
+    // 1. The ranks beyond P fold into their siblings, as in binary swap.
+    if (rank >= p) {
+        send_rect(comm, rank - p, kTagFold, mine, nonempty_rect(mine, whole), st);
+        return done(Partial{});
+    }
+    std::vector<float> px;
+    if (rank < extras) {
+        const KdNode& pair = d.nodes[size_t(slot_node(d, rank, rank + 1))];
+        const Rect r = recv_rect(comm, rank + p, kTagFold, px);
+        composite_into(mine, r, px.data(), !low_in_front(pair, eye, dir, orthographic));
+    }
+    // 2. Rounds of g ranks: the slots of an aligned block of unit * g slots that differ only in
+    // their digit (slot / unit) % g; the part of the rows a rank keeps is its digit's.
+    int r0 = 0, r1 = mine.height;
+    Partial acc{mine.width, mine.height, std::vector<float>(mine.rgba.size(), 0.f)};
+    for (int unit = 1; unit < p;) {
+        int g = 1;
+        while (g < k && unit * g * 2 <= p) g *= 2;
+        const int a = rank - rank % (unit * g);
+        const int me = (rank / unit) % g;
+        auto part = [&](int q) {
+            return Rect{0, r0 + (r1 - r0) * q / g, mine.width, r0 + (r1 - r0) * (q + 1) / g};
+        };
+        // The g pieces of my part, by digit: mine, and the others' by exchange (step j pairs
+        // digit x with x XOR j, a perfect matching: no cycle of waiting ranks).
+        std::vector<Rect> rects(static_cast<size_t>(g));
+        std::vector<std::vector<float>> pieces(static_cast<size_t>(g));
+        const Rect keep = part(me);
+        rects[size_t(me)] = keep.empty() ? Rect{} : nonempty_rect(mine, keep);
+        pieces[size_t(me)] = pack(mine, rects[size_t(me)]);
+        for (int j = 1; j < g; ++j) {
+            const int other = me ^ j;
+            const int peer = a + other * unit + rank % unit;
+            const Rect give = part(other);
+            const Rect out_r = give.empty() ? Rect{} : nonempty_rect(mine, give);
+            Rect in_r;
+            comm.sendrecv(peer, kTagSwap, &out_r, sizeof out_r, &in_r, sizeof in_r);
+            const std::vector<float> out_px = pack(mine, out_r);
+            std::vector<float>& in_px = pieces[size_t(other)];
+            in_px.assign(size_t(in_r.pixels()) * 4, 0.f);
+            comm.sendrecv(peer, kTagSwap + 1, out_px.data(), out_px.size() * sizeof(float),
+                          in_px.data(), in_px.size() * sizeof(float));
+            st.bytes_sent += sizeof out_r + out_px.size() * sizeof(float);
+            rects[size_t(other)] = in_r;
+        }
+        // Front to back over zero in the block's visibility order, then back into `mine`.
+        for (int y = keep.y0; y < keep.y1; ++y)
+            std::fill_n(acc.at(0, y), size_t(mine.width) * 4, 0.f);
+        for (int q : block_order(d, a, a + unit * g, unit, eye, dir, orthographic)) {
+            const int digit = q - a / unit;
+            composite_into(acc, rects[size_t(digit)], pieces[size_t(digit)].data(), false);
+        }
+        for (int y = keep.y0; y < keep.y1; ++y)
+            std::copy_n(acc.at(0, y), size_t(mine.width) * 4, mine.at(0, y));
+        r0 = keep.y0, r1 = keep.y1;
+        unit *= g;
+    }
+    // 3. Rank 0 gathers the strips.
+    const Rect strip{0, r0, mine.width, r1};
+    if (rank != 0) {
+        send_rect(comm, 0, kTagGather, mine, strip.empty() ? Rect{} : nonempty_rect(mine, strip),
+                  st);
+        return done(Partial{});
+    }
+    Partial out;
+    out.width = mine.width, out.height = mine.height;
+    out.rgba.assign(mine.rgba.size(), 0.f);
+    const std::vector<float> own = pack(mine, strip);
+    composite_into(out, strip, own.data(), true);
+    for (int q = 1; q < p; ++q) {
+        const Rect r = recv_rect(comm, q, kTagGather, px);
+        composite_into(out, r, px.data(), true);
     }
     return done(std::move(out));
 }

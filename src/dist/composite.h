@@ -18,6 +18,12 @@
 //                current rows in halves, each sends the half it gives up and composites the half
 //                it keeps in the node's order; then rank 0 gathers the P strips. A rank beyond P
 //                first folds into its sibling (slot s < N - P).
+//   radix-k      (Peterka et al. 2009, IceT's default): binary swap with rounds of k ranks
+//                instead of 2. P = k1 * k2 * ...; in round i the k_i ranks whose slots differ
+//                only in digit i (an aligned block of slots: a subtree of the kd-tree) split their
+//                rows in k_i parts, each keeps one and receives that part from the k_i - 1 others
+//                (k_i - 1 exchanges, partner = index XOR j), and composites the k_i pieces in the
+//                subtree's visibility order. k = 2 is binary swap; the default k is 4.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -28,7 +34,7 @@
 
 namespace lacuna::dist {
 
-enum class Composite { Direct, BinarySwap };
+enum class Composite { Direct, BinarySwap, RadixK };
 std::string to_string(Composite c);
 
 // A rectangle of pixels [x0, x1) x [y0, y1); empty when x0 >= x1 or y0 >= y1.
@@ -68,5 +74,14 @@ Partial composite_direct(Comm& comm, const Partial& mine, const std::vector<int>
 // visibility_order.
 Partial composite_binary_swap(Comm& comm, Partial mine, const Decomposition& d, Vec3f eye,
                               Vec3f dir, bool orthographic, CompositeStats& stats);
+
+// The same by radix-k with rounds of `k` ranks (a power of two >= 2; the last round takes what
+// divides what is left).
+Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3f eye, Vec3f dir,
+                          bool orthographic, int k, CompositeStats& stats);
+// The slot blocks of size `unit` in slots [a, b) (b - a a power-of-two multiple of `unit`) front
+// to back: the kd-tree's visibility order of the subtree, by block index (a / unit, ...).
+std::vector<int> block_order(const Decomposition& d, int a, int b, int unit, Vec3f eye, Vec3f dir,
+                             bool orthographic);
 
 }  // namespace lacuna::dist

@@ -61,10 +61,10 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
         whole_bounds = world_bounds(whole);
         out.whole_voxels = whole.voxel_count();
         me.voxels_read = whole.voxel_count();
-        out.decomposition = options.balance == Balance::Visible
-                                ? decompose_visible(whole, discretise(tf, whole.vis_range()),
-                                                    comm.size(), threads)
-                                : decompose_voxels(whole.dims(), comm.size());
+        out.decomposition =
+            options.balance == Balance::Visible
+                ? decompose_visible(whole, discretise(tf, whole.vis_range()), comm.size(), threads)
+                : decompose_voxels(whole.dims(), comm.size());
         own = ownership(out.decomposition, comm.rank());
         brick = crop_brick(whole, own.offset, brick_voxels(out.decomposition, comm.rank()));
     }
@@ -96,10 +96,21 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
     const bool ortho = cam.projection() == Projection::Orthographic;
     Partial mine{f.width, f.height, std::move(r.rgba_float)};
     CompositeStats cs;
-    Partial done =
-        options.composite == Composite::Direct
-            ? composite_direct(comm, mine, visibility_order(out.decomposition, eye, dir, ortho), cs)
-            : composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir, ortho, cs);
+    Partial done;
+    switch (options.composite) {
+        case Composite::Direct:
+            done = composite_direct(comm, mine,
+                                    visibility_order(out.decomposition, eye, dir, ortho), cs);
+            break;
+        case Composite::BinarySwap:
+            done = composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir, ortho,
+                                         cs);
+            break;
+        case Composite::RadixK:
+            done = composite_radix_k(comm, std::move(mine), out.decomposition, eye, dir, ortho,
+                                     options.radix, cs);
+            break;
+    }
     if (f.count_samples) {
         comm.sum_to_root(r.sample_counts);
         if (comm.rank() == 0) out.sample_counts = std::move(r.sample_counts);

@@ -13,9 +13,8 @@
 // to the float association of compositing (within 1/255 per channel; tests/dist/).
 #pragma once
 #include <functional>
-#include <vector>
-
 #include <optional>
+#include <vector>
 
 #include "dist/brick_io.h"
 #include "dist/comm.h"
@@ -32,6 +31,7 @@ namespace lacuna::dist {
 struct DistOptions {
     Balance balance = Balance::Voxels;
     Composite composite = Composite::Direct;
+    int radix = 4;  // radix-k's k
 };
 
 // One rank's account of the frame (plain data: gathered on rank 0 as bytes).
@@ -44,7 +44,7 @@ struct RankReport {
     double composite_seconds = 0;  // this rank's part of compositing
     double cpu_seconds = 0;        // CPU time of the render (all its threads)
     uint64_t samples = 0, rays = 0;
-    uint64_t voxels = 0;  // voxels of the brick (ghost layer included)
+    uint64_t voxels = 0;       // voxels of the brick (ghost layer included)
     uint64_t voxels_read = 0;  // voxels read from the file (the brick's, or the whole file's)
     uint64_t visible_cells =
         0;                    // cells of the brick's box the TF can make visible (0: not counted)
@@ -52,7 +52,7 @@ struct RankReport {
 };
 
 struct DistFrame {
-    Image image;                    // rank 0 only
+    Image image;  // rank 0 only
     // Per pixel, the samples of every rank summed (rank 0, when the spec's count_samples): the
     // single-process counts of --accel none exactly (every lattice sample once).
     std::vector<uint32_t> sample_counts;
@@ -67,8 +67,8 @@ using VolumeLoader = std::function<Volume()>;
 
 // Where the ranks' voxels come from (brick_io.h).
 struct VolumeSource {
-    VolumeLoader load_whole;            // any file: read whole by every rank, the brick cut out
-    std::optional<RawBrickFile> raw;    // set: bricks read by offset (with Balance::Voxels)
+    VolumeLoader load_whole;              // any file: read whole by every rank, the brick cut out
+    std::optional<RawBrickFile> raw;      // set: bricks read by offset (with Balance::Voxels)
     std::optional<ValueRange> vis_range;  // the front end's visualization range (--range), if any
 };
 

@@ -95,7 +95,7 @@ constexpr const char* kFrame = "--tf mr-default --size 64 --azimuth 40 --elevati
 
 TEST(MpiRender, NoneOnEveryRankCount) {
     check_frames(shells_volume().string(), std::string(kFrame) + " --accel none", "none",
-                 {1, 2, 3, 4, 7}, {"direct", "binary-swap"});
+                 {1, 2, 3, 4, 7}, {"direct", "binary-swap", "radix-k"});
 }
 
 TEST(MpiRender, GridBitfieldKdtreeMatchOneProcess) {
@@ -106,7 +106,7 @@ TEST(MpiRender, GridBitfieldKdtreeMatchOneProcess) {
 
 TEST(MpiRender, VisibleBalanceOrthographicAndInside) {
     check_frames(shells_volume().string(), std::string(kFrame) + " --ortho --balance visible",
-                 "ortho", {3, 4}, {"direct", "binary-swap"});
+                 "ortho", {3, 4}, {"binary-swap", "radix-k"});
     check_frames(
         shells_volume().string(),
         "--tf mr-default --size 48 --azimuth 0 --elevation 0 --zoom 12 --fov 60 --accel grid",
@@ -137,20 +137,23 @@ TEST(MpiRender, OnlyRankZeroWritesAndReports) {
 // and the frame is the one-process frame, the visualization range agreed from the bricks'.
 TEST(MpiRender, RawBricksAreReadByOffset) {
     const fs::path raw = dir() / "shells_45x38x52_uint8.raw";
-    ASSERT_EQ(run_cli("generate sphere-shells --dims 45x38x52 --out " + raw.string() + " --quiet", dir()).code, 0);
+    ASSERT_EQ(
+        run_cli("generate sphere-shells --dims 45x38x52 --out " + raw.string() + " --quiet", dir())
+            .code,
+        0);
     for (int n : {2, 4}) {
-        check_frames(raw.string(), std::string(kFrame) + " --accel bitfield", "raw" + std::to_string(n), {n},
-                     {"direct"});
-        const CliResult m = run_mpi(n, "render " + raw.string() + " " + kFrame + " --rank-times --out " +
-                                           (dir() / "raw.png").string());
+        check_frames(raw.string(), std::string(kFrame) + " --accel bitfield",
+                     "raw" + std::to_string(n), {n}, {"direct"});
+        const CliResult m = run_mpi(n, "render " + raw.string() + " " + kFrame +
+                                           " --rank-times --out " + (dir() / "raw.png").string());
         ASSERT_EQ(m.code, 0) << m.err;
         int rows = 0;
         for (size_t p = m.out.find("\n"); p != std::string::npos; p = m.out.find("\n", p + 1)) {
             int rank;
             double f[7], voxels, read;
             unsigned long long samples;
-            if (std::sscanf(m.out.c_str() + p + 1, "%d %lf %lf %lf %lf %lf %llu %lf %lf", &rank, &f[0], &f[1],
-                            &f[2], &f[3], &f[4], &samples, &voxels, &read) == 9) {
+            if (std::sscanf(m.out.c_str() + p + 1, "%d %lf %lf %lf %lf %lf %llu %lf %lf", &rank,
+                            &f[0], &f[1], &f[2], &f[3], &f[4], &samples, &voxels, &read) == 9) {
                 ++rows;
                 EXPECT_EQ(read, voxels) << m.out;  // the brick, not the file
                 EXPECT_LT(read, 100.0 / n + 10.0) << m.out;
@@ -170,8 +173,8 @@ TEST(MpiRender, HeatmapOfNoneIsTheOneProcessHeatmap) {
     ASSERT_EQ(r.code, 0) << r.err;
     for (int n : {3, 4}) {
         const fs::path heat = dir() / ("h_" + std::to_string(n) + "_heat.png");
-        const CliResult m = run_mpi(n, frame + " --out " + (dir() / "h.png").string() +
-                                           " --heatmap " + heat.string());
+        const CliResult m = run_mpi(
+            n, frame + " --out " + (dir() / "h.png").string() + " --heatmap " + heat.string());
         ASSERT_EQ(m.code, 0) << m.err;
         EXPECT_EQ(slurp_file(heat), slurp_file(dir() / "h_ref_heat.png")) << n << " ranks";
     }
