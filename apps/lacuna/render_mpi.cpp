@@ -73,11 +73,10 @@ void render_mpi(const MpiRenderJob& job) {
     dist::DistFrame f;
     try {
         f = dist::render_distributed(comm, source, job.tf, job.spec, o, job.threads);
-    } catch (const Error& e) {
-        // A rank's own failure (its brick, its memory): the others may wait in a collective,
-        // so the job ends here with the CLI's exit code for errors.
-        if (comm.size() == 1) throw;
-        std::fprintf(stderr, "lacuna: rank %d: %s\n", comm.rank(), e.what());
+    } catch (const dist::RankFailure& e) {
+        // One rank's own failure while rendering: the others may wait for its messages, so the
+        // job ends here with the CLI's exit code for errors.
+        std::fprintf(stderr, "lacuna: %s\n", e.what());
         comm.abort(2);
     }
     if (comm.rank() != 0) return;

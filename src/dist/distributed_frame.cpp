@@ -3,10 +3,14 @@
 #include <sched.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <exception>
+#include <optional>
 
 #include "core/parallel.h"
 #include "dist/brick_io.h"
+#include "lacuna/error.h"
 #include "lacuna/orientation.h"
 #include "lacuna/session.h"
 #include "render/pixel_driver.h"
@@ -21,6 +25,27 @@ double seconds_since(Clock::time_point t0) {
 }
 
 }  // namespace
+
+// Whether any rank failed, learnt by every rank before any waits in the frame's collectives: a
+// failure becomes an exception on every rank (a failed rank's own; on the others the first
+// failed rank's message), so every rank leaves the frame and the CLI prints one line (rank 0's).
+static void agree(Comm& comm, const std::exception_ptr& failed, const std::string& what) {
+    struct Word {
+        int32_t failed;
+        char what[508];
+    };
+    Word mine{};
+    mine.failed = failed ? 1 : 0;
+    std::snprintf(mine.what, sizeof mine.what, "%s", what.c_str());
+    const std::vector<uint8_t> all = comm.allgather(&mine, sizeof mine);
+    if (failed) std::rethrow_exception(failed);
+    for (int r = 0; r < comm.size(); ++r) {
+        Word w;
+        std::memcpy(&w, all.data() + size_t(r) * sizeof w, sizeof w);
+        w.what[sizeof w.what - 1] = 0;
+        if (w.failed) throw Error("rank " + std::to_string(r) + ": " + w.what);
+    }
+}
 
 int rank_threads(int requested) {
     if (requested > 0) return requested;
@@ -43,96 +68,124 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
     Box3f whole_bounds;
     Volume brick;
     BrickOwnership own;
-    if (source.raw && options.balance == Balance::Voxels) {
-        // By offset: the header alone gives the grid; each rank reads its brick, then all agree
-        // on the whole volume's range from their bricks' (which cover every voxel).
-        const Volume header = header_of(*source.raw);
-        whole_bounds = world_bounds(header);
-        out.whole_voxels = header.voxel_count();
-        out.decomposition = decompose_voxels(header.dims(), comm.size());
-        own = ownership(out.decomposition, comm.rank());
-        brick = read_brick(*source.raw, own.offset, brick_voxels(out.decomposition, comm.rank()));
-        me.voxels_read = brick.voxel_count();
-        float lo = brick.data_range().min, hi = brick.data_range().max;
+    const bool by_offset = source.raw && options.balance == Balance::Voxels;
+    float lo = 0, hi = 0;
+    std::exception_ptr failed;
+    std::string what;
+    try {
+        if (by_offset) {
+            // By offset: the header alone gives the grid; each rank reads its brick, then all
+            // agree on the whole volume's range from their bricks' (which cover every voxel).
+            const Volume header = header_of(*source.raw);
+            whole_bounds = world_bounds(header);
+            out.whole_voxels = header.voxel_count();
+            out.decomposition = decompose_voxels(header.dims(), comm.size());
+            own = ownership(out.decomposition, comm.rank());
+            brick =
+                read_brick(*source.raw, own.offset, brick_voxels(out.decomposition, comm.rank()));
+            me.voxels_read = brick.voxel_count();
+            lo = brick.data_range().min, hi = brick.data_range().max;
+        } else {
+            const Volume whole = source.load_whole();
+            whole_bounds = world_bounds(whole);
+            out.whole_voxels = whole.voxel_count();
+            me.voxels_read = whole.voxel_count();
+            out.decomposition = options.balance == Balance::Visible
+                                    ? decompose_visible(whole, discretise(tf, whole.vis_range()),
+                                                        comm.size(), threads)
+                                    : decompose_voxels(whole.dims(), comm.size());
+            own = ownership(out.decomposition, comm.rank());
+            brick = crop_brick(whole, own.offset, brick_voxels(out.decomposition, comm.rank()));
+        }
+    } catch (const std::exception& e) {
+        failed = std::current_exception();
+        what = e.what();
+    }
+    agree(comm, failed, what);
+    if (by_offset) {
         comm.minmax(lo, hi);
         brick.set_vis_range(source.vis_range ? *source.vis_range : default_vis_range(lo, hi));
-    } else {
-        const Volume whole = source.load_whole();
-        whole_bounds = world_bounds(whole);
-        out.whole_voxels = whole.voxel_count();
-        me.voxels_read = whole.voxel_count();
-        out.decomposition =
-            options.balance == Balance::Visible
-                ? decompose_visible(whole, discretise(tf, whole.vis_range()), comm.size(), threads)
-                : decompose_voxels(whole.dims(), comm.size());
-        own = ownership(out.decomposition, comm.rank());
-        brick = crop_brick(whole, own.offset, brick_voxels(out.decomposition, comm.rank()));
     }
     me.load_seconds = seconds_since(t0);
     me.voxels = brick.voxel_count();
     // 2. The brick's session: its structure, then its owned samples.
-    Session session(std::move(brick), threads);
-    session.set_brick(own, whole_bounds);
-    session.set_transfer_function(tf);
+    std::optional<Session> session;
     FrameSpec f = spec;
     f.keep_float = true;
     t0 = Clock::now();
-    session.prepare(f);
-    session.refine();
+    try {
+        session.emplace(std::move(brick), threads);
+        session->set_brick(own, whole_bounds);
+        session->set_transfer_function(tf);
+        session->prepare(f);
+        session->refine();
+    } catch (const std::exception& e) {
+        failed = std::current_exception();
+        what = e.what();
+    }
+    agree(comm, failed, what);
     me.build_seconds = seconds_since(t0);
-    comm.barrier();  // the frame's time starts when every rank is ready
-    const auto frame0 = Clock::now();
-    FrameResult r = session.render(f);
-    me.render_seconds = r.stats.seconds;
-    me.cpu_seconds = r.stats.cpu_seconds;
-    me.samples = r.stats.samples;
-    me.rays = r.stats.rays;
-    // 3. Compositing in the kd-tree's order for this view (eye and ray direction in whole index
-    // space: the volume frame over the spacing).
-    const Camera cam = to_volume_frame(volume_frame(session.volume()), session.camera(f));
-    const Vec3d sp = session.volume().spacing;
-    const Vec3f inv{float(1.0 / sp.x), float(1.0 / sp.y), float(1.0 / sp.z)};
-    const Vec3f eye = cam.eye() * inv, dir = cam.forward() * inv;
-    const bool ortho = cam.projection() == Projection::Orthographic;
-    Partial mine{f.width, f.height, std::move(r.rgba_float)};
-    CompositeStats cs;
-    Partial done;
-    switch (options.composite) {
-        case Composite::Direct:
-            done = composite_direct(comm, mine,
-                                    visibility_order(out.decomposition, eye, dir, ortho), cs);
-            break;
-        case Composite::BinarySwap:
-            done = composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir, ortho,
-                                         cs);
-            break;
-        case Composite::RadixK:
-            done = composite_radix_k(comm, std::move(mine), out.decomposition, eye, dir, ortho,
-                                     options.radix, cs);
-            break;
-    }
-    if (f.count_samples) {
-        comm.sum_to_root(r.sample_counts);
-        if (comm.rank() == 0) out.sample_counts = std::move(r.sample_counts);
-    }
-    me.composite_seconds = cs.seconds;
-    me.bytes_sent = cs.bytes_sent;
-    if (comm.rank() == 0) {
-        // The single-process pixel rule (pixel_driver.h): background behind, clamp, round.
-        out.image = Image(f.width, f.height);
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const float* c = done.at(x, y);
-                const uint32_t w = pixel_word(f.background, kernel::Accum{c[0], c[1], c[2], c[3]});
-                std::memcpy(out.image.pixel(x, y), &w, 4);
-            }
-        out.frame_seconds = seconds_since(frame0);
-    }
-    // 4. Every rank's report on rank 0.
-    const std::vector<uint8_t> all = comm.gather(&me, sizeof me);
-    if (comm.rank() == 0) {
-        out.ranks.resize(size_t(comm.size()));
-        std::memcpy(out.ranks.data(), all.data(), all.size());
+    // 3. Render and composite. A failure now is this rank's alone while the others may wait
+    // for its messages: it leaves as a RankFailure, which ends the job.
+    try {
+        comm.barrier();  // the frame's time starts when every rank is ready
+        const auto frame0 = Clock::now();
+        FrameResult r = session->render(f);
+        me.render_seconds = r.stats.seconds;
+        me.cpu_seconds = r.stats.cpu_seconds;
+        me.samples = r.stats.samples;
+        me.rays = r.stats.rays;
+        // 3. Compositing in the kd-tree's order for this view (eye and ray direction in whole index
+        // space: the volume frame over the spacing).
+        const Camera cam = to_volume_frame(volume_frame(session->volume()), session->camera(f));
+        const Vec3d sp = session->volume().spacing;
+        const Vec3f inv{float(1.0 / sp.x), float(1.0 / sp.y), float(1.0 / sp.z)};
+        const Vec3f eye = cam.eye() * inv, dir = cam.forward() * inv;
+        const bool ortho = cam.projection() == Projection::Orthographic;
+        Partial mine{f.width, f.height, std::move(r.rgba_float)};
+        CompositeStats cs;
+        Partial done;
+        switch (options.composite) {
+            case Composite::Direct:
+                done = composite_direct(comm, mine,
+                                        visibility_order(out.decomposition, eye, dir, ortho), cs);
+                break;
+            case Composite::BinarySwap:
+                done = composite_binary_swap(comm, std::move(mine), out.decomposition, eye, dir,
+                                             ortho, cs);
+                break;
+            case Composite::RadixK:
+                done = composite_radix_k(comm, std::move(mine), out.decomposition, eye, dir, ortho,
+                                         options.radix, cs);
+                break;
+        }
+        if (f.count_samples) {
+            comm.sum_to_root(r.sample_counts);
+            if (comm.rank() == 0) out.sample_counts = std::move(r.sample_counts);
+        }
+        me.composite_seconds = cs.seconds;
+        me.bytes_sent = cs.bytes_sent;
+        if (comm.rank() == 0) {
+            // The single-process pixel rule (pixel_driver.h): background behind, clamp, round.
+            out.image = Image(f.width, f.height);
+            for (int y = 0; y < f.height; ++y)
+                for (int x = 0; x < f.width; ++x) {
+                    const float* c = done.at(x, y);
+                    const uint32_t w =
+                        pixel_word(f.background, kernel::Accum{c[0], c[1], c[2], c[3]});
+                    std::memcpy(out.image.pixel(x, y), &w, 4);
+                }
+            out.frame_seconds = seconds_since(frame0);
+        }
+        // 4. Every rank's report on rank 0.
+        const std::vector<uint8_t> all = comm.gather(&me, sizeof me);
+        if (comm.rank() == 0) {
+            out.ranks.resize(size_t(comm.size()));
+            std::memcpy(out.ranks.data(), all.data(), all.size());
+        }
+    } catch (const std::exception& e) {
+        if (comm.size() == 1) throw;
+        throw RankFailure("rank " + std::to_string(comm.rank()) + ": " + e.what());
     }
     return out;
 }

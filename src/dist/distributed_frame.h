@@ -20,6 +20,7 @@
 #include "dist/comm.h"
 #include "dist/composite.h"
 #include "dist/decomposition.h"
+#include "lacuna/error.h"
 #include "lacuna/frame_spec.h"
 #include "lacuna/image.h"
 #include "lacuna/renderer.h"
@@ -75,6 +76,14 @@ struct VolumeSource {
 // Worker threads of a rank: `requested`, or for 0 the cores this process may run on (its CPU
 // affinity, which mpirun sets when it binds ranks to cores).
 int rank_threads(int requested);
+
+// A failure of one rank after every rank has loaded its brick and built its structure (then the
+// others may be waiting for its messages): the front end ends the job (Comm::abort). Failures
+// before that (a missing file, a bad frame) are every rank's alike and thrown as they are, on
+// every rank.
+struct RankFailure : Error {
+    using Error::Error;
+};
 
 // `threads` as rank_threads() resolves it.
 DistFrame render_distributed(Comm& comm, const VolumeSource& source, const TransferFunction& tf,

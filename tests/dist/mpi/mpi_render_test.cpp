@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "apps/cli_run.h"
 #include "lacuna/image.h"
@@ -191,6 +192,25 @@ TEST(MpiRender, RefusedFramesAreOneLineFromRankZero) {
             ++lines;
         EXPECT_EQ(lines, 1u) << flags << ": " << m.err;
         EXPECT_FALSE(fs::exists(dir() / "refused.png"));
+    }
+}
+
+// A failure every rank meets while loading (a file that is not there, a raw file of the wrong
+// size) is agreed on before any rank waits for another: one line, from rank 0, no abort.
+TEST(MpiRender, LoadFailuresAreOneLineFromRankZero) {
+    const fs::path bad = dir() / "short_45x38x52_uint8.raw";
+    {
+        std::ofstream f(bad, std::ios::binary);
+        f << "too short";
+    }
+    for (const std::string vol : {(dir() / "absent.nrrd").string(), bad.string()}) {
+        const CliResult m = run_mpi(3, "render " + vol + " " + kFrame + " --out " + (dir() / "absent.png").string());
+        EXPECT_EQ(m.code, 2) << vol << ": " << m.err;
+        size_t lines = 0;
+        for (size_t p = m.err.find("lacuna:"); p != std::string::npos; p = m.err.find("lacuna:", p + 1))
+            ++lines;
+        EXPECT_EQ(lines, 1u) << vol << ": " << m.err;
+        EXPECT_EQ(m.err.find("MPI_ABORT"), std::string::npos) << m.err;
     }
 }
 
