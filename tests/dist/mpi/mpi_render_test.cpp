@@ -203,11 +203,13 @@ TEST(MpiRender, LoadFailuresAreOneLineFromRankZero) {
         std::ofstream f(bad, std::ios::binary);
         f << "too short";
     }
-    for (const std::string vol : {(dir() / "absent.nrrd").string(), bad.string()}) {
-        const CliResult m = run_mpi(3, "render " + vol + " " + kFrame + " --out " + (dir() / "absent.png").string());
+    for (const std::string& vol : {(dir() / "absent.nrrd").string(), bad.string()}) {
+        const CliResult m = run_mpi(
+            3, "render " + vol + " " + kFrame + " --out " + (dir() / "absent.png").string());
         EXPECT_EQ(m.code, 2) << vol << ": " << m.err;
         size_t lines = 0;
-        for (size_t p = m.err.find("lacuna:"); p != std::string::npos; p = m.err.find("lacuna:", p + 1))
+        for (size_t p = m.err.find("lacuna:"); p != std::string::npos;
+             p = m.err.find("lacuna:", p + 1))
             ++lines;
         EXPECT_EQ(lines, 1u) << vol << ": " << m.err;
         EXPECT_EQ(m.err.find("MPI_ABORT"), std::string::npos) << m.err;
