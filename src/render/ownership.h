@@ -66,17 +66,17 @@ inline void owned_run(const kernel::IndexRay& r, float t_base, float dt, int k_e
         };
         int b, e;
         if (d[a] > 0.f) {  // p increases: [first p >= lo, first p >= hi)
-            b = std::isinf(lo[a])
+            b = lo[a] == -INFINITY
                     ? 0
                     : first_true(guess(lo[a]), k_end, [&](int k) { return p(k) >= lo[a]; });
-            e = std::isinf(hi[a])
+            e = hi[a] == INFINITY
                     ? k_end
                     : first_true(guess(hi[a]), k_end, [&](int k) { return p(k) >= hi[a]; });
         } else {  // p decreases: [first p < hi, first p < lo)
-            b = std::isinf(hi[a])
+            b = hi[a] == INFINITY
                     ? 0
                     : first_true(guess(hi[a]), k_end, [&](int k) { return p(k) < hi[a]; });
-            e = std::isinf(lo[a])
+            e = lo[a] == -INFINITY
                     ? k_end
                     : first_true(guess(lo[a]), k_end, [&](int k) { return p(k) < lo[a]; });
         }

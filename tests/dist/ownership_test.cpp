@@ -40,7 +40,7 @@ TEST(Ownership, OwnedRunIsExactlyTheSamplesInTheBox) {
         for (int a = 0; a < 3; ++a) {
             lo[a] = rng.coin(4) ? -INFINITY : float(rng.range(-5, 20));
             hi[a] = rng.coin(4) ? INFINITY : lo[a] + float(rng.range(1, 20));
-            if (std::isinf(lo[a]) && !std::isinf(hi[a])) hi[a] = float(rng.range(-5, 30));
+            if (lo[a] == -INFINITY && hi[a] != INFINITY) hi[a] = float(rng.range(-5, 30));
         }
         int ka, kb;
         owned_run(r, t_base, dt, k_end, lo, hi, ka, kb);
