@@ -106,17 +106,17 @@ void render_mpi(const MpiRenderJob& job) {
         f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
         double(bytes) / (1 << 20));
     if (job.mpi.rank_times) {
-        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %8s %10s\n", "rank", "load ms", "build ms",
-                    "render ms", "composite ms", "CPU ms", "samples", "voxels%", "read%",
-                    "sent KiB");
+        std::printf("%4s %9s %9s %10s %12s %10s %12s %8s %8s %10s %9s\n", "rank", "load ms",
+                    "build ms", "render ms", "composite ms", "CPU ms", "samples", "voxels%",
+                    "read%", "sent KiB", "peak MiB");
         for (const auto& r : f.ranks)
             std::printf(
-                "%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %8.1f %10.1f\n", r.rank,
+                "%4d %9.1f %9.1f %10.1f %12.1f %10.1f %12llu %8.1f %8.1f %10.1f %9.1f\n", r.rank,
                 r.load_seconds * 1e3, r.build_seconds * 1e3, r.render_seconds * 1e3,
                 r.composite_seconds * 1e3, r.cpu_seconds * 1e3, (unsigned long long)r.samples,
                 100.0 * double(r.voxels) / double(std::max<uint64_t>(f.whole_voxels, 1)),
                 100.0 * double(r.voxels_read) / double(std::max<uint64_t>(f.whole_voxels, 1)),
-                double(r.bytes_sent) / 1024);
+                double(r.bytes_sent) / 1024, double(r.peak_rss_kib) / 1024);
     }
     if (!job.heatmap.empty()) std::printf("wrote %s\n", job.heatmap.c_str());
     std::printf("wrote %s\n", job.out.c_str());

@@ -1,6 +1,7 @@
 #include "dist/distributed_frame.h"
 
 #include <sched.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -178,6 +179,8 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
             out.frame_seconds = seconds_since(frame0);
         }
         // 4. Every rank's report on rank 0.
+        rusage ru{};
+        if (getrusage(RUSAGE_SELF, &ru) == 0) me.peak_rss_kib = uint64_t(ru.ru_maxrss);
         const std::vector<uint8_t> all = comm.gather(&me, sizeof me);
         if (comm.rank() == 0) {
             out.ranks.resize(size_t(comm.size()));

@@ -48,8 +48,10 @@ struct RankReport {
     uint64_t voxels = 0;       // voxels of the brick (ghost layer included)
     uint64_t voxels_read = 0;  // voxels read from the file (the brick's, or the whole file's)
     uint64_t visible_cells =
-        0;                    // cells of the brick's box the TF can make visible (0: not counted)
-    uint64_t bytes_sent = 0;  // compositing
+        0;  // cells of the brick's box the TF can make visible (0: not counted)
+    uint64_t bytes_sent = 0;
+    uint64_t peak_rss_kib =
+        0;  // the rank's peak resident memory at the frame's end  // compositing
 };
 
 struct DistFrame {
