@@ -244,8 +244,8 @@ void render_tile_brick(const S& accel, const Volume& vol, const T* data, const B
                     // 3. The brick's structure walks the ray in brick index space over the run
                     // and a sample of margin each side; its segments are rounded outward to the
                     // whole lattice as always (pixel_driver.h), then clipped to the run.
-                    CursorRay cr = cursor_ray(r);
-                    for (int a = 0; a < 3; ++a) cr.o[a] -= off[a];
+                    IndexRay cr = r;
+                    cr.ox -= off[0], cr.oy -= off[1], cr.oz -= off[2];
                     const float c0 = std::max(t_near, t_near + (float(ka) - 0.5f) * dt);
                     const float c1 = std::min(t_far, t_near + (float(kb) + 0.5f) * dt);
                     typename S::Cursor cursor(accel, cr, c0, c1, dt, 0.f);
