@@ -14,6 +14,14 @@
 // (c, r) is at origin + c u + r v, RAS mm), so a click is a world point: it becomes the crosshair,
 // the other planes are fetched through it, and a `probe` message reads the value there. Each pane
 // has at most one slice in flight (newest state when it arrives), as the 3D view does.
+//
+// Saving work (docs/viewer.md "Saving work"): the TF buttons send `tf_export` (the server writes
+// lacuna TF JSON or Slicer .vp.json with the library's writers) and `tf_import` (an uploaded file
+// read by the library's readers, answered as lacuna TF JSON for the editor); the screenshot button
+// sends `screenshot` (the server renders the view at full resolution and sends the PNG); the
+// session button sends `session` (the server writes the session file `lacuna render --session`
+// reads). Each answer becomes a download. Screenshot and session carry the same view state at the
+// same size, so the session renders to the screenshot's bytes.
 'use strict';
 
 (() => {
@@ -73,6 +81,8 @@
     ws.onclose = () => {
       setStatus('disconnected: is `lacuna serve` still running?');
       inFlight = null;
+      shotInFlight = null;
+      fileRequests.clear();
       probeInFlight = null;
       for (const pane of Object.values(panes)) pane.inFlight = null;
     };
@@ -81,9 +91,12 @@
   function onText(msg) {
     if (msg.type === 'hello') return onHello(msg);
     if (msg.type === 'probe') return onProbe(msg);
+    if (msg.type === 'session' || msg.type === 'tf_export' || msg.type === 'tf_import') return onFile(msg);
     if (msg.type === 'error') {
       // The server rejected a request: show it (not a console error: the page stays usable).
       setStatus('server: ' + msg.message);
+      if (msg.id !== null && fileRequests.has(msg.id)) fileRequests.delete(msg.id);
+      if (msg.id !== null && msg.id === shotInFlight) { shotInFlight = null; $('screenshot').disabled = false; }
       if (msg.id !== null && msg.id === inFlight) { inFlight = null; flush(); }
       for (const pane of Object.values(panes)) {
         if (msg.id !== null && msg.id === pane.inFlight) { pane.inFlight = null; flushSlice(pane); }
@@ -109,6 +122,9 @@
     }
     setTf(msg.tf);
     presets.value = msg.presets[msg.tf.name] ? msg.tf.name : '';
+    // Session files name the server's volume file (a server without one cannot write them).
+    $('session-save').disabled = !msg.session;
+    showShotSize();
     setStatus('');
     request(false);
     startSlices(msg);
@@ -120,6 +136,7 @@
     const n = bytes[0] | (bytes[1] << 8) | (bytes[2] << 16) | (bytes[3] << 24);
     const header = JSON.parse(new TextDecoder().decode(bytes.subarray(4, 4 + n)));
     if (header.type === 'slice') onSlice(header, bytes.subarray(4 + n));
+    else if (header.type === 'screenshot') onScreenshot(header, bytes.subarray(4 + n));
     else onFrame(header, bytes.subarray(4 + n));
   }
 
@@ -157,22 +174,106 @@
     flush();
   }
 
-  function flush() {
-    if (!dirty || inFlight !== null || !ws || ws.readyState !== WebSocket.OPEN || !state.tf) return;
+  // The 3D view's size in device pixels (at most 2 per CSS pixel and max_side).
+  function viewSize() {
     const dpr = Math.min(window.devicePixelRatio || 1, 2);
     const max = hello ? hello.limits.max_side : 2048;
-    const w = Math.max(1, Math.min(max, Math.round(view.clientWidth * dpr)));
-    const h = Math.max(1, Math.min(max, Math.round(view.clientHeight * dpr)));
-    const id = nextId++;
-    ws.send(JSON.stringify({
-      type: 'render', id, width: w, height: h, preview: dirtyPreview,
+    return [Math.max(1, Math.min(max, Math.round(view.clientWidth * dpr))),
+            Math.max(1, Math.min(max, Math.round(view.clientHeight * dpr)))];
+  }
+  // The view state every render, screenshot and session message carries.
+  function viewState(type, id, [w, h]) {
+    return {
+      type, id, width: w, height: h,
       camera: state.camera, renderer: state.renderer, accel: state.accel,
       ert: state.ert, step: state.step, tf: state.tf, shading: state.shading, clip: state.clip,
       clip_planes: state.clipPlanes, segments: state.segments, hide: state.hide,
-    }));
+    };
+  }
+
+  function flush() {
+    if (!dirty || inFlight !== null || !ws || ws.readyState !== WebSocket.OPEN || !state.tf) return;
+    const id = nextId++;
+    ws.send(JSON.stringify({ ...viewState('render', id, viewSize()), preview: dirtyPreview }));
     inFlight = id;
     dirty = false;
   }
+
+  // ---- saving work: TF files, screenshot, session --------------------------------------------
+  const fileRequests = new Map();  // id -> the file name the answer is saved as
+  let shotInFlight = null;
+  const safeName = (name) => (name || '').replace(/[^A-Za-z0-9._-]+/g, '-').replace(/^[-.]+/, '') || 'tf';
+  // The screenshot's (and the session's) size: the view's times the menu's factor, both sides
+  // scaled alike and kept within max_side.
+  function shotSize() {
+    const [w, h] = viewSize(), max = hello ? hello.limits.max_side : 2048;
+    const k = Math.min(Number($('shot-scale').value) || 1, max / w, max / h);
+    return [Math.max(1, Math.round(w * k)), Math.max(1, Math.round(h * k))];
+  }
+  function showShotSize() { $('shot-size').textContent = shotSize().join('×'); }
+  function download(blob, name) {
+    const a = document.createElement('a');
+    a.href = URL.createObjectURL(blob);
+    a.download = name;
+    document.body.appendChild(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 60_000);
+  }
+  function sendFileRequest(msg, name) {
+    if (!ws || ws.readyState !== WebSocket.OPEN || !state.tf) return;
+    fileRequests.set(msg.id, name);
+    ws.send(JSON.stringify(msg));
+  }
+  function onFile(msg) {
+    const name = fileRequests.get(msg.id);
+    fileRequests.delete(msg.id);
+    if (msg.type === 'tf_import') {
+      setTf(msg.tf);
+      $('preset').value = '';
+      setStatus(`loaded ${name}`);
+      request(false);
+      return;
+    }
+    download(new Blob([msg.text], { type: 'application/json' }), name || 'lacuna.json');
+    setStatus('');
+  }
+  function onScreenshot(header, png) {
+    if (header.id === shotInFlight) shotInFlight = null;
+    download(new Blob([png], { type: 'image/png' }), `lacuna-${header.width}x${header.height}.png`);
+    setStatus(`screenshot ${header.width}×${header.height}: ${header.frame_ms.toFixed(0)} ms`);
+    $('screenshot').disabled = false;
+  }
+  $('tf-download').addEventListener('click', () => {
+    const id = nextId++;
+    sendFileRequest({ type: 'tf_export', id, format: 'lacuna', tf: state.tf }, safeName(state.tf.name) + '.json');
+  });
+  $('tf-slicer').addEventListener('click', () => {
+    const id = nextId++;
+    sendFileRequest({ type: 'tf_export', id, format: 'slicer', tf: state.tf }, safeName(state.tf.name) + '.vp.json');
+  });
+  $('tf-upload').addEventListener('click', () => $('tf-file').click());
+  $('tf-file').addEventListener('change', async (e) => {
+    const file = e.target.files[0];
+    e.target.value = '';
+    if (!file) return;
+    const text = await file.text();
+    sendFileRequest({ type: 'tf_import', id: nextId++, name: file.name, text }, file.name);
+  });
+  $('shot-scale').addEventListener('change', showShotSize);
+  $('screenshot').addEventListener('click', () => {
+    if (shotInFlight !== null || !ws || ws.readyState !== WebSocket.OPEN || !state.tf) return;
+    const id = nextId++;
+    const size = shotSize();
+    ws.send(JSON.stringify(viewState('screenshot', id, size)));
+    shotInFlight = id;
+    $('screenshot').disabled = true;
+    setStatus(`rendering a ${size.join('×')} screenshot…`);
+  });
+  $('session-save').addEventListener('click', () => {
+    const id = nextId++;
+    sendFileRequest(viewState('session', id, shotSize()), 'lacuna-session.json');
+  });
 
   // ---- overlay ----------------------------------------------------------------------------
   function setStatus(text) {
@@ -269,7 +370,7 @@
     state.camera.pan = [clamp(state.camera.pan[0] - dx * k, -50, 50),
                         clamp(state.camera.pan[1] + dy * k, -50, 50)];
   }
-  window.addEventListener('resize', () => request(false));
+  window.addEventListener('resize', () => { request(false); if (hello) showShotSize(); });
 
   // ---- controls -----------------------------------------------------------------------------
   function fillSelect(sel, names, value) {
@@ -376,11 +477,17 @@
 
   // ---- transfer function editor -------------------------------------------------------------
   // Takes a TF from the server (a preset or the initial one) into the editor's normalized form.
+  // A value-domain TF (a Slicer file, a value preset) becomes normalized over its range, else the
+  // volume's visualization range: the range its LUT is discretised over. Points outside it are
+  // cut at its ends (the piecewise-linear function evaluated there), so the TF stays the same
+  // over the range instead of clamping points onto its ends.
   function setTf(tf) {
     const copy = JSON.parse(JSON.stringify(tf));
     if (copy.domain === 'value') {
       const [lo, hi] = copy.range || hello.volume.vis_range;
       const norm = (x) => clamp((x - lo) / (hi - lo), 0, 1);
+      copy.color = clipPoints(copy.color, lo, hi);
+      copy.opacity = clipPoints(copy.opacity, lo, hi);
       copy.color.forEach((p) => { p[0] = norm(p[0]); });
       copy.opacity.forEach((p) => { p[0] = norm(p[0]); });
       copy.domain = 'normalized';
@@ -390,6 +497,27 @@
     state.tf = copy;
     selectedStop = -1;
     drawTf();
+  }
+  // Points [x, ...values] sorted by x (two may share an x: a step, the second wins at x) cut to
+  // [lo, hi]: unchanged when all lie inside, else the inside points between the function's
+  // values at lo (from the right) and at hi (from the left, and from the right when a step sits
+  // on hi).
+  function clipPoints(pts, lo, hi) {
+    if (pts.every((p) => p[0] >= lo && p[0] <= hi)) return pts;
+    const lerp = (a, b, x) => a.slice(1).map((v, k) => v + (x - a[0]) / (b[0] - a[0]) * (b[k + 1] - v));
+    // The value at x from the right (right = true) or from the left.
+    const at = (x, right) => {
+      if (right ? x < pts[0][0] : x <= pts[0][0]) return pts[0].slice(1);
+      const last = pts[pts.length - 1];
+      if (right ? x >= last[0] : x > last[0]) return last.slice(1);
+      let i = 0;
+      while (right ? pts[i + 1][0] <= x : pts[i + 1][0] < x) i++;
+      return lerp(pts[i], pts[i + 1], x);
+    };
+    const out = [[lo, ...at(lo, true)], ...pts.filter((p) => p[0] > lo && p[0] < hi), [hi, ...at(hi, false)]];
+    const right = at(hi, true);
+    if (right.some((v, k) => v !== out[out.length - 1][k + 1])) out.push([hi, ...right]);
+    return out;
   }
   function edited() {
     state.tf.name = 'edited';

@@ -35,6 +35,13 @@ void run(const ServeArgs& a) {
     so.initial_tf = resolve_transfer_function(
         !a.tf.empty() ? a.tf : (vol.type() == VoxelType::Int16 ? "ct-bone" : "mr-default"));
     so.volume_name = std::filesystem::path(a.volume.path).filename().string();
+    // What the page's session files name (read as `lacuna render --save-session` writes it).
+    SessionVolume sv;
+    sv.path = std::filesystem::absolute(a.volume.path).lexically_normal().string();
+    sv.frame = a.volume.frame;
+    sv.raw = raw_spec_of(a.volume);
+    if (!a.volume.range.empty()) sv.range = parse_range(a.volume.range);
+    so.session_volume = sv;
     AccelOptions ao;
     ao.leaf_cells = a.leaf;
     ao.bitfield_bits = a.bits;

@@ -20,6 +20,9 @@ struct Image {
 // Writes a PNG atomically: to a temporary file beside `path`, then renamed over it, so a
 // failure never leaves a partial file. Throws lacuna::Error(path, "output", reason).
 void write_png(const std::string& path, const Image& img);
+// The bytes write_png writes for `img`, in memory (the viewer's screenshot: the same encoder and
+// settings, so a screenshot equals `lacuna render`'s PNG byte for byte). Throws lacuna::Error.
+std::string png_bytes(const Image& img);
 // Reads an 8-bit RGB/RGBA PNG (tests, comparisons). Throws lacuna::Error on failure.
 Image read_png(const std::string& path);
 

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -143,6 +144,26 @@ void write_png(const std::string& path, const Image& img) {
         throw Error(path, "output", std::string("cannot write: ") + std::strerror(e));
     }
     io::sync_dir(tmp.dir);
+}
+
+std::string png_bytes(const Image& img) {
+    if (img.width <= 0 || img.height <= 0 ||
+        img.rgba.size() != size_t(img.width) * size_t(img.height) * 4)
+        throw Error("png", "image", "invalid image " + std::to_string(img.width) + "x" +
+                                        std::to_string(img.height));
+    // open_memstream: a FILE over a growing buffer, so encode_png writes exactly what it writes
+    // to a file. buf and size are valid after fclose.
+    char* buf = nullptr;
+    size_t size = 0;
+    FILE* fp = ::open_memstream(&buf, &size);
+    if (!fp) throw Error("png", "memory", std::string("cannot encode: ") + std::strerror(errno));
+    PngMessage msg;
+    const int rc = encode_png(fp, img, msg);
+    const bool failed = std::fclose(fp) != 0 || rc != 0;
+    std::string out = failed || !buf ? std::string() : std::string(buf, size);
+    std::free(buf);
+    if (failed) throw Error("png", "image", std::string("cannot encode: ") + (msg.text[0] ? msg.text : "out of memory"));
+    return out;
 }
 
 Image read_png(const std::string& path) {

@@ -133,19 +133,49 @@ json vec_json(Vec3d v) {
     return json::array({v.x, v.y, v.z});
 }
 
+// A message's "tf": bounded in points, then validated by the library's own reader (shape,
+// ranges, sorting), which throws lacuna::Error naming the field.
+TransferFunction tf_of(const json& j, const Limits& limits) {
+    const json& tf = need(j, "tf", "");
+    if (!tf.is_object()) reject("tf", "expected a transfer-function object");
+    size_t points = 0;
+    for (const char* key : {"color", "opacity", "gradient_opacity"})
+        if (auto it = tf.find(key); it != tf.end() && it->is_array()) points += it->size();
+    if (points > size_t(limits.max_tf_points))
+        reject("tf", std::to_string(points) + " points; expected at most " +
+                         std::to_string(limits.max_tf_points));
+    return parse_transfer_function(tf.dump(), "tf");
+}
+
 }  // namespace
+
+// The message types by kind, in message_names()'s order.
+constexpr std::pair<MessageKind, const char*> kMessageNames[] = {
+    {MessageKind::Render, "render"},         {MessageKind::Slice, "slice"},
+    {MessageKind::Probe, "probe"},           {MessageKind::Screenshot, "screenshot"},
+    {MessageKind::Session, "session"},       {MessageKind::TfExport, "tf_export"},
+    {MessageKind::TfImport, "tf_import"}};
+
+const char* message_name(MessageKind k) {
+    for (const auto& [kind, name] : kMessageNames)
+        if (kind == k) return name;
+    return "?";
+}
 
 MessageKind message_kind(std::string_view text, const Limits& limits) {
     const json j = parse_json(text, limits);
     const std::string type = text_of(j, "type", "");
-    if (type == "render") return MessageKind::Render;
-    if (type == "slice") return MessageKind::Slice;
-    if (type == "probe") return MessageKind::Probe;
-    reject("type", "unknown message type '" + type.substr(0, 40) + "'; expected render, slice or probe");
+    for (const auto& [kind, name] : kMessageNames)
+        if (type == name) return kind;
+    std::string list;
+    for (const auto& [kind, name] : kMessageNames) list += (list.empty() ? "" : ", ") + std::string(name);
+    reject("type", "unknown message type '" + type.substr(0, 40) + "'; expected one of: " + list);
 }
 
 std::vector<std::string> message_names() {
-    return {"render", "slice", "probe"};
+    std::vector<std::string> out;
+    for (const auto& [kind, name] : kMessageNames) out.push_back(name);
+    return out;
 }
 
 SliceRequest parse_slice_request(std::string_view text, const Limits& limits) {
@@ -220,6 +250,34 @@ std::string probe_message(uint64_t id, const ProbeResult& p) {
     return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
+std::string screenshot_message(const ScreenshotInfo& s, std::string_view png) {
+    const std::string header = json{{"type", "screenshot"},   {"id", s.id},
+                                    {"width", s.width},       {"height", s.height},
+                                    {"frame_ms", s.frame_ms}, {"encode_ms", s.encode_ms}}
+                                   .dump();
+    std::string out(4, '\0');
+    const uint32_t n = uint32_t(header.size());
+    for (int b = 0; b < 4; ++b) out[size_t(b)] = char((n >> (8 * b)) & 0xff);
+    out += header;
+    out.append(png.data(), png.size());
+    return out;
+}
+
+std::string session_message(uint64_t id, const std::string& session_text) {
+    return json{{"type", "session"}, {"id", id}, {"text", session_text}}.dump(
+        -1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string tf_export_message(uint64_t id, TfFileFormat format, const std::string& file_text) {
+    return json{{"type", "tf_export"}, {"id", id}, {"format", to_string(format)}, {"text", file_text}}
+        .dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string tf_import_message(uint64_t id, const TransferFunction& tf) {
+    return json{{"type", "tf_import"}, {"id", id}, {"tf", json::parse(to_json(tf))}}.dump(
+        -1, ' ', false, json::error_handler_t::replace);
+}
+
 std::string to_string(RendererKind k) {
     switch (k) {
         case RendererKind::March:
@@ -234,19 +292,29 @@ std::vector<std::string> renderer_names() {
     return {"march", "slice"};
 }
 
-ViewRequest parse_request(std::string_view text, const Limits& limits) {
-    const json j = parse_json(text, limits);
+namespace {
+
+// The view state of render, screenshot and session messages (screenshots and sessions have no
+// "preview": they are the full-resolution frame).
+ViewRequest parse_view(const json& j, MessageKind kind, const Limits& limits) {
     const std::string type = text_of(j, "type", "");
-    if (type != "render") reject("type", "unknown message type '" + type + "'; expected render");
-    only_keys(j,
-              {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
-               "step", "tf", "shading", "clip", "clip_planes", "segments", "hide"},
-              "");
+    if (type != message_name(kind))
+        reject("type", "unknown message type '" + type.substr(0, 40) + "'; expected " + message_name(kind));
+    if (kind == MessageKind::Render)
+        only_keys(j,
+                  {"type", "id", "width", "height", "preview", "camera", "renderer", "accel",
+                   "ert", "step", "tf", "shading", "clip", "clip_planes", "segments", "hide"},
+                  "");
+    else
+        only_keys(j,
+                  {"type", "id", "width", "height", "camera", "renderer", "accel", "ert", "step",
+                   "tf", "shading", "clip", "clip_planes", "segments", "hide"},
+                  "");
     ViewRequest r;
     r.id = id_of(j);
     r.width = integer(j, "width", 1, limits.max_side, "");
     r.height = integer(j, "height", 1, limits.max_side, "");
-    r.preview = boolean(j, "preview", "");
+    r.preview = kind == MessageKind::Render && boolean(j, "preview", "");
     const json& cam = need(j, "camera", "");
     if (!cam.is_object()) reject("camera", "expected an object");
     only_keys(cam, {"view", "azimuth", "elevation", "zoom", "pan"}, "camera.");
@@ -342,18 +410,54 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
     if ((r.shading && !cap.has(Feature::Shading)) || (clipped && !cap.has(Feature::ClipPlanes)))
         reject(asked, "the " + to_string(target) + " renderer has no shading or clipping");
     r.step = float(number(j, "step", 0.1, 8, ""));
+    r.tf = tf_of(j, limits);
+    return r;
+}
 
-    const json& tf = need(j, "tf", "");
-    if (!tf.is_object()) reject("tf", "expected a transfer-function object");
-    size_t points = 0;
-    for (const char* key : {"color", "opacity"})
-        if (auto it = tf.find(key); it != tf.end() && it->is_array()) points += it->size();
-    if (points > size_t(limits.max_tf_points))
-        reject("tf", std::to_string(points) + " points; expected at most " +
-                         std::to_string(limits.max_tf_points));
-    // The library's own reader validates the TF (shape, ranges, sorting) and throws
-    // lacuna::Error naming the field.
-    r.tf = parse_transfer_function(tf.dump(), "tf");
+}  // namespace
+
+ViewRequest parse_request(std::string_view text, const Limits& limits) {
+    return parse_view(parse_json(text, limits), MessageKind::Render, limits);
+}
+
+ViewRequest parse_view_request(std::string_view text, MessageKind kind, const Limits& limits) {
+    if (kind != MessageKind::Render && kind != MessageKind::Screenshot && kind != MessageKind::Session)
+        reject("type", std::string("expected render, screenshot or session, not ") + message_name(kind));
+    return parse_view(parse_json(text, limits), kind, limits);
+}
+
+std::string to_string(TfFileFormat f) {
+    return f == TfFileFormat::Slicer ? "slicer" : "lacuna";
+}
+
+TfExportRequest parse_tf_export_request(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    if (text_of(j, "type", "") != "tf_export") reject("type", "expected tf_export");
+    only_keys(j, {"type", "id", "format", "tf"}, "");
+    TfExportRequest r;
+    r.id = id_of(j);
+    const std::string format = text_of(j, "format", "");
+    if (format == "lacuna")
+        r.format = TfFileFormat::Lacuna;
+    else if (format == "slicer")
+        r.format = TfFileFormat::Slicer;
+    else
+        reject("format", "unknown '" + format.substr(0, 40) + "'; expected lacuna or slicer");
+    r.tf = tf_of(j, limits);
+    return r;
+}
+
+TfImportRequest parse_tf_import_request(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    if (text_of(j, "type", "") != "tf_import") reject("type", "expected tf_import");
+    only_keys(j, {"type", "id", "name", "text"}, "");
+    TfImportRequest r;
+    r.id = id_of(j);
+    r.name = text_of(j, "name", "");
+    if (r.name.size() > 255) reject("name", "expected a file name of at most 255 characters");
+    for (char c : r.name)
+        if (static_cast<unsigned char>(c) < 0x20) reject("name", "expected a file name without control characters");
+    r.text = text_of(j, "text", "");
     return r;
 }
 
@@ -413,6 +517,7 @@ std::string hello_message(const HelloInfo& h) {
     j["capabilities"] = caps;
     j["labels"] = h.labels;
     j["messages"] = message_names();
+    j["session"] = h.session;
     j["slice_views"] = {{"planes", {"axial", "coronal", "sagittal"}},
                         {"interpolations", {"trilinear", "nearest"}}};
     j["limits"] = {{"max_message_bytes", h.limits.max_message_bytes},

@@ -18,12 +18,25 @@
 //    ["overlay_opacity":[0,1] (the label overlay; needs `serve --labels`), "max_size":N]}
 //   {"type":"probe", "id":N, "point":[x,y,z], ["interpolation":...]}
 //   Slices and probes are answered in order, never dropped (lacuna/mpr.h: one slice <= 30 ms).
+//   {"type":"screenshot", ...every key of "render" but "preview"...}: that view rendered at
+//    width x height on the render thread, never reduced (no preview, no render budget) and never
+//    dropped for a newer render; answered as PNG bytes (lacuna::png_bytes: `lacuna render`'s
+//    encoder, so the bytes of `lacuna render --session` of the same state). One at a time per tab.
+//   {"type":"session", ...the same keys...}: the session file of that view (session/session_file.h,
+//    what `lacuna render --session FILE` reads): the server's volume path and read options, the
+//    TF, the FrameSpec the frame would be rendered with.
+//   {"type":"tf_export", "id":N, "format":"lacuna|slicer", "tf":{...}}: the TF as a file's text
+//    (lacuna TF JSON or Slicer .vp.json, serve/tf_files.h).
+//   {"type":"tf_import", "id":N, "name":"file name", "text":"..."}: an uploaded TF file (lacuna
+//    JSON, Slicer .vp.json or .vp), answered with the TF as lacuna TF JSON.
 //   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
 //   with an "error" message naming the field; the connection stays open.
 // Server -> page:
 //   text   {"type":"hello", ...}    once, on connect: volume, histogram, presets, accels,
 //                                    renderers, capabilities, limits, "messages" (the
-//                                    types the server answers: render, slice, probe) and
+//                                    types the server answers: render, slice, probe,
+//                                    screenshot, session, tf_export, tf_import), "session"
+//                                    (true when the server can write session files) and
 //                                    "slice_views" {"planes", "interpolations"}
 //          "capabilities": {"march": {"accels": [...], "features": [...]}, "slice": {...},
 //                           "segments": {"renderer": "march", "accels": [...], "features": [...]}}
@@ -38,6 +51,10 @@
 //           row r from the top) is at origin + c u + r v, RAS mm, so a click maps to the world
 //   text   {"type":"probe", "id", "point", "inside", "index":[continuous], "voxel":[i,j,k]|null,
 //           "value"|null, "voxel_value"|null, "label"|null, "label_name"}
+//   binary [u32 LE n][{"type":"screenshot", "id", "width", "height", "frame_ms", "encode_ms"}][PNG]
+//   text   {"type":"session", "id", "text":"...the session file..."}
+//   text   {"type":"tf_export", "id", "format", "text":"...the file..."}
+//   text   {"type":"tf_import", "id", "tf":{...lacuna TF JSON...}}
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -113,9 +130,9 @@ struct ProbeRequest {
 };
 
 // The kinds of message the page sends, by "type".
-enum class MessageKind { Render, Slice, Probe };
+enum class MessageKind { Render, Slice, Probe, Screenshot, Session, TfExport, TfImport };
 // The message's "type" (throws lacuna::Error("message", "type"/"json"/..., ...) like
-// parse_request for anything but render, slice or probe).
+// parse_request for a type not in message_names()).
 MessageKind message_kind(std::string_view text, const Limits& limits = {});
 SliceRequest parse_slice_request(std::string_view text, const Limits& limits = {});
 ProbeRequest parse_probe_request(std::string_view text, const Limits& limits = {});
@@ -132,6 +149,26 @@ Structure frame_structure(AccelKind accel, bool segments, const AccelOptions& o 
 // Parses one message from the page. Throws lacuna::Error("message", field, expectation) for
 // anything malformed, oversized or out of range; never anything else.
 ViewRequest parse_request(std::string_view text, const Limits& limits = {});
+// A "screenshot" or "session" message: the view state of a render message, parsed by the same
+// code (every key of render but "preview"; the result has preview = false). `kind` is the type
+// the message must have.
+ViewRequest parse_view_request(std::string_view text, MessageKind kind, const Limits& limits = {});
+
+enum class TfFileFormat { Lacuna, Slicer };  // lacuna TF JSON, Slicer .vp.json
+std::string to_string(TfFileFormat f);
+struct TfExportRequest {
+    uint64_t id = 0;
+    TfFileFormat format = TfFileFormat::Lacuna;
+    TransferFunction tf;
+};
+struct TfImportRequest {
+    uint64_t id = 0;
+    std::string name;  // the file's name (picks the reader: .vp.json, .vp, else lacuna JSON)
+    std::string text;  // its contents
+};
+TfExportRequest parse_tf_export_request(std::string_view text, const Limits& limits = {});
+TfImportRequest parse_tf_import_request(std::string_view text, const Limits& limits = {});
+
 // Best effort: the "id" of a rejected message, to echo in the error (nullopt if none).
 std::optional<uint64_t> request_id(std::string_view text, const Limits& limits = {});
 
@@ -142,6 +179,7 @@ struct HelloInfo {
     TransferFunction initial_tf;      // the TF the page starts with
     std::vector<std::string> accels, renderers;
     int labels = 0;  // label values of the server's label volume (0: none loaded)
+    bool session = false;  // the server knows its volume's file (session messages can be answered)
     Limits limits;
 };
 std::string hello_message(const HelloInfo& h);
@@ -178,6 +216,17 @@ struct SliceInfo {
 std::string slice_header(const SliceInfo& s);
 std::string slice_message(const SliceInfo& s, std::string_view jpeg);
 std::string probe_message(uint64_t id, const ProbeResult& p);
+
+// The screenshot's binary message: [u32 LE header length][header][PNG bytes].
+struct ScreenshotInfo {
+    uint64_t id = 0;
+    int width = 0, height = 0;
+    double frame_ms = 0, encode_ms = 0;
+};
+std::string screenshot_message(const ScreenshotInfo& s, std::string_view png);
+std::string session_message(uint64_t id, const std::string& session_text);
+std::string tf_export_message(uint64_t id, TfFileFormat format, const std::string& file_text);
+std::string tf_import_message(uint64_t id, const TransferFunction& tf);
 
 std::string error_message(const std::string& message, std::optional<uint64_t> id);
 

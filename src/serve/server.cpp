@@ -27,8 +27,10 @@
 
 #include "core/cancel.h"
 #include "lacuna/error.h"
+#include "lacuna/image.h"
 #include "serve/assets.h"
 #include "serve/jpeg.h"
+#include "serve/tf_files.h"
 
 namespace lacuna::serve {
 
@@ -112,6 +114,7 @@ struct Server::Impl {
     // which a newer request of that tab or the tab's closing sets (core/cancel.h: the renderers
     // stop between two tiles).
     const WsSession* rendering = nullptr;
+    bool rendering_screenshot = false;  // a newer render of the tab does not cancel a screenshot
     std::atomic<bool> cancel_frame{false};
     // Render thread only: milliseconds per pixel-sample-step unit (w * h / step) of the last
     // frame of each cost_key, the render budget's estimate.
@@ -124,6 +127,7 @@ struct Server::Impl {
     bool evict_idlest();
     void submit(const std::shared_ptr<WsSession>& s);
     void render_loop();
+    std::string render_screenshot(const ViewRequest& req);
     void close_all();
 };
 
@@ -173,6 +177,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
     // The latest-wins slot, shared with the render thread (Impl::slot_mutex).
     std::optional<ViewRequest> pending;
+    // A screenshot waiting for the render thread (never dropped for a newer render; one a tab).
+    std::optional<ViewRequest> screenshot;
+    bool screenshot_busy = false;  // queued or rendering: a second one is refused
     Clock::time_point pending_received;
     bool in_ready = false;
 
@@ -203,20 +210,24 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         } else {
             try {
                 const MessageKind kind = message_kind(text, m_server->options.limits);
-                if (kind != MessageKind::Render) {
+                if (kind == MessageKind::Slice || kind == MessageKind::Probe) {
                     answer_slice_or_probe(kind, text);
-                    read();
-                    return;
+                } else if (kind == MessageKind::Screenshot) {
+                    queue_screenshot(text);
+                } else if (kind != MessageKind::Render) {
+                    answer_file_message(kind, text);
+                } else {
+                    ViewRequest req = parse_request(text, m_server->options.limits);
+                    {
+                        std::lock_guard<std::mutex> lock(m_server->slot_mutex);
+                        pending = std::move(req);  // latest wins: an unrendered request is dropped
+                        pending_received = Clock::now();
+                        // ... and so is the frame of this tab being rendered (not a screenshot).
+                        if (m_server->rendering == this && !m_server->rendering_screenshot)
+                            m_server->cancel_frame = true;
+                    }
+                    m_server->submit(shared_from_this());
                 }
-                ViewRequest req = parse_request(text, m_server->options.limits);
-                {
-                    std::lock_guard<std::mutex> lock(m_server->slot_mutex);
-                    pending = std::move(req);  // latest wins: an unrendered request is dropped
-                    pending_received = Clock::now();
-                    // ... and so is the frame of this tab being rendered.
-                    if (m_server->rendering == this) m_server->cancel_frame = true;
-                }
-                m_server->submit(shared_from_this());
             } catch (const Error& e) {
                 send_text(error_message(e.what(), request_id(text, m_server->options.limits)));
             }
@@ -255,12 +266,85 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         }
     }
 
+    // A screenshot goes to the render thread (it owns the renderer); one per tab at a time.
+    void queue_screenshot(const std::string& text) {
+        ViewRequest req = parse_view_request(text, MessageKind::Screenshot, m_server->options.limits);
+        {
+            std::lock_guard<std::mutex> lock(m_server->slot_mutex);
+            if (screenshot_busy)
+                throw Error("screenshot", "id",
+                            "this tab's previous screenshot is still rendering; ask for one at a time");
+            screenshot_busy = true;
+            screenshot = std::move(req);
+        }
+        m_server->submit(shared_from_this());
+    }
+
+  public:
+    // The render thread's screenshot went out (or failed): the tab may ask for the next one.
+    void screenshot_done(std::string message, bool binary) {
+        {
+            std::lock_guard<std::mutex> lock(m_server->slot_mutex);
+            screenshot_busy = false;
+        }
+        if (binary) {
+            m_binaries.push_back(std::move(message));
+            pump();
+        } else {
+            send_text(std::move(message));
+        }
+    }
+
+  private:
+    // Session files and TF files, on the network thread: they read only what never changes once
+    // the server runs (the volume's geometry and ranges, the options), no rendering.
+    void answer_file_message(MessageKind kind, const std::string& text) {
+        const Limits& limits = m_server->options.limits;
+        const FrameRenderer& renderer = m_server->renderer;
+        if (kind == MessageKind::Session) {
+            const ViewRequest req = parse_view_request(text, MessageKind::Session, limits);
+            const auto& volume = m_server->options.session_volume;
+            if (!volume)
+                throw Error("session", "volume",
+                            "this server's volume has no file to name (it was made in memory)");
+            if (req.segments && renderer.label_count() > 0)
+                throw Error("session", "segments",
+                            "a session file does not hold the label map yet; switch segments off "
+                            "to save the session");
+            SessionFile f;
+            f.volume = *volume;
+            f.tf = req.tf;
+            f.frame = renderer.frame_spec(req, req.width, req.height);
+            send_text(session_message(req.id, to_json(f, "session")));
+            return;
+        }
+        if (kind == MessageKind::TfExport) {
+            const TfExportRequest req = parse_tf_export_request(text, limits);
+            const Volume& v = renderer.volume();
+            const double smallest = std::min({v.spacing.x, v.spacing.y, v.spacing.z});
+            send_text(tf_export_message(
+                req.id, req.format,
+                req.format == TfFileFormat::Slicer ? to_slicer_vp_json(req.tf, v.vis_range(), smallest)
+                                                   : to_json(req.tf)));
+            return;
+        }
+        const TfImportRequest req = parse_tf_import_request(text, limits);
+        const TransferFunction tf = read_tf_file(req.name, req.text);
+        const size_t points = tf.color.size() + tf.opacity.size() + tf.rendering.gradient_opacity.size();
+        if (points > size_t(limits.max_tf_points))
+            throw Error(req.name, "points", std::to_string(points) + "; the viewer takes at most " +
+                                                std::to_string(limits.max_tf_points));
+        send_text(tf_import_message(req.id, tf));
+    }
+
     void finish() {
         {
             // A closed tab's queued request is not rendered.
             std::lock_guard<std::mutex> lock(m_server->slot_mutex);
             if (pending) ++m_server->dropped;
+            if (screenshot) ++m_server->dropped;
             pending.reset();
+            screenshot.reset();
             if (m_server->rendering == this) m_server->cancel_frame = true;
         }
         if (m_server->sessions.erase(shared_from_this()) && m_server->options.log)
@@ -476,6 +560,7 @@ void Server::Impl::render_loop() {
     for (;;) {
         std::shared_ptr<WsSession> s;
         ViewRequest req;
+        std::optional<ViewRequest> shot;
         Clock::time_point received;
         {
             std::unique_lock<std::mutex> lock(slot_mutex);
@@ -485,13 +570,47 @@ void Server::Impl::render_loop() {
             ready.pop_front();
             if (!s) continue;
             s->in_ready = false;
-            if (!s->pending) continue;
-            req = std::move(*s->pending);
-            s->pending.reset();
-            received = s->pending_received;
+            if (s->screenshot) {
+                // The screenshot first; the tab's pending render (if any) waits its next turn.
+                shot = std::move(*s->screenshot);
+                s->screenshot.reset();
+                if (s->pending) {
+                    s->in_ready = true;
+                    ready.push_back(s);
+                }
+            } else {
+                if (!s->pending) continue;
+                req = std::move(*s->pending);
+                s->pending.reset();
+                received = s->pending_received;
+            }
             rendering = s.get();
+            rendering_screenshot = shot.has_value();
             cancel_frame = false;
             ++started;
+        }
+        if (shot) {
+            // Full size, never reduced; cancelled only by the tab's closing. A failure is one
+            // error reply; the server goes on.
+            std::string reply;
+            bool binary = false;
+            try {
+                const CancelScope cancellable(cancel_frame);
+                reply = render_screenshot(*shot);
+                binary = true;
+            } catch (const Cancelled&) {
+                ++cancelled;
+            } catch (const std::exception& e) {
+                reply = error_message(std::string("screenshot: ") + e.what(), shot->id);
+            }
+            if (!reply.empty())
+                net::post(ioc, [s, m = std::move(reply), binary]() mutable {
+                    s->screenshot_done(std::move(m), binary);
+                });
+            std::lock_guard<std::mutex> lock(slot_mutex);
+            rendering = nullptr;
+            rendering_screenshot = false;
+            continue;
         }
         std::string message;
         try {
@@ -577,6 +696,21 @@ void Server::Impl::render_loop() {
     }
 }
 
+// A screenshot: the request's frame at its own size, as `lacuna render` writes it (the session's
+// frame through the CLI's PNG encoder).
+std::string Server::Impl::render_screenshot(const ViewRequest& req) {
+    Frame f = renderer.render(req, req.width, req.height);
+    ScreenshotInfo info;
+    info.id = req.id;
+    info.width = req.width;
+    info.height = req.height;
+    info.frame_ms = f.stats.seconds * 1e3;
+    const Clock::time_point e0 = Clock::now();
+    const std::string png = png_bytes(f.image);
+    info.encode_ms = ms_between(e0, Clock::now());
+    return screenshot_message(info, png);
+}
+
 void Server::Impl::close_all() {
     stopping = true;
     beast::error_code ec;
@@ -598,6 +732,7 @@ Server::Server(FrameRenderer& renderer, ServerOptions options)
     h.accels = accel_names();
     h.renderers = renderer_names();
     h.labels = renderer.label_count();
+    h.session = m->options.session_volume.has_value();
     h.limits = m->options.limits;
     m->hello = hello_message(h);
 }

@@ -22,7 +22,10 @@
 //     a newer request of the tab, or its closing, also cancels its frame in progress between
 //     two tiles (core/cancel.h; a structure's first build runs to its end);
 //   - a malformed or unrenderable message is answered with an "error" message naming the field;
-//     the connection and the server stay up.
+//     the connection and the server stay up;
+//   - a screenshot is rendered at its full size (no preview, no budget: the user asked for it),
+//     one per tab at a time, before the tab's pending render; a newer render does not cancel it,
+//     closing the tab does.
 //
 // Security: binds 127.0.0.1 unless told otherwise; serves only the page embedded in the binary
 // (no path from the browser is ever opened); on a loopback address it accepts only Host
@@ -36,6 +39,7 @@
 
 #include "serve/frame_renderer.h"
 #include "serve/protocol.h"
+#include "session/session_file.h"
 
 namespace lacuna::serve {
 
@@ -53,6 +57,9 @@ struct ServerOptions {
     // Estimated render time above which a frame is rendered reduced (0: no budget).
     double render_budget_ms = 2000;
     std::string volume_name;           // shown by the page
+    // The volume's file and read options, for the page's "session" messages (the session file
+    // `lacuna render --session` reads); nullopt (a volume made in memory): they are refused.
+    std::optional<SessionVolume> session_volume;
     TransferFunction initial_tf = preset("mr-default");
     int jpeg_quality = 88;
     int preview_quality = 75;
