@@ -5,7 +5,10 @@
 // console errors, and that Ctrl-C (SIGINT) stops the server cleanly. Then patient orientation
 // (issue 14): on a phantom stored LPS, the page's view menu and its clip-plane box give the frames
 // `lacuna render --view ... --clip ...` gives, byte for byte (the frame's JPEG against the CLI's
-// PNG through the server's own encoder, --jpeg). Saves a screenshot of the viewer to --screenshot
+// PNG through the server's own encoder, --jpeg). Saving work: the TF downloaded as lacuna JSON and
+// exported as Slicer .vp.json (both rendered by `lacuna render --tf`) and uploaded back into the
+// editor; the screenshot button's PNG equals `lacuna render --session` of the saved session, byte
+// for byte. Saves a screenshot of the viewer to --screenshot
 // (default docs/images/viewer.png, the README picture; ctest passes a path in the build folder so
 // a test run leaves the checkout untouched).
 //
@@ -26,7 +29,7 @@ const dir = mkdtempSync(join(tmpdir(), 'lacuna-e2e-'));
 let server = null;
 let server2 = null;  // the orientation part's server (the LPS phantom)
 let browser = null;
-const watchdog = setTimeout(() => fail('timed out after 150 s'), 150_000);
+const watchdog = setTimeout(() => fail("timed out after 270 s"), 270_000);
 
 function fail(message) {
   console.error(`e2e.viewer: FAIL: ${message}`);
@@ -275,6 +278,81 @@ try {
     const st2 = await page.evaluate(() => window.lacunaViewer.state);
     check(st2.renderer === 'march' && st2.accel === 'bitfield',
           `a structure the slicer lacks switches to the marcher (${st2.renderer}, ${st2.accel})`);
+  }
+
+  // Saving work (issue 18 item 2): the TF as lacuna JSON and as Slicer .vp.json, both read by
+  // `lacuna render --tf`, uploaded back into the editor; a screenshot rendered by the server and a
+  // saved session that `lacuna render --session` renders to the screenshot's bytes.
+  {
+    const saved = async (button, name) => {
+      const [dl] = await Promise.all([page.waitForEvent('download', { timeout: 60_000 }), page.click(button)]);
+      const path = join(dir, name);
+      await dl.saveAs(path);
+      return { path, suggested: dl.suggestedFilename() };
+    };
+    const cliRender = (flags) => {
+      try {
+        execFileSync(args.lacuna, ['render', ...flags], { stdio: 'pipe' });
+        return 0;
+      } catch (e) {
+        console.error(String(e.stderr || e));
+        return e.status ?? 1;
+      }
+    };
+    const edited = await page.evaluate(() => JSON.parse(JSON.stringify(window.lacunaViewer.state.tf)));
+    const tfJson = await saved('#tf-download', 'downloaded-tf.json');
+    const tfFile = JSON.parse(readFileSync(tfJson.path, 'utf8'));
+    check(tfJson.suggested.endsWith('.json') && JSON.stringify(tfFile.opacity) === JSON.stringify(edited.opacity) &&
+          JSON.stringify(tfFile.color) === JSON.stringify(edited.color) && tfFile.domain === edited.domain,
+          `the TF download is the editor's TF as lacuna JSON (${tfJson.suggested}, ${tfFile.opacity.length} opacity points)`);
+    check(cliRender([volume, '--tf', tfJson.path, '--size', '48', '--out', join(dir, 'tf-json.png')]) === 0,
+          'lacuna render --tf reads the downloaded TF');
+    const vp = await saved('#tf-slicer', 'exported.vp.json');
+    const vpDoc = JSON.parse(readFileSync(vp.path, 'utf8'));
+    const comp = vpDoc.volumeProperties[0].components[0];
+    check(vp.suggested.endsWith('.vp.json') && comp.scalarOpacity.points.length === edited.opacity.length &&
+          comp.rgbTransferFunction.points.length === edited.color.length,
+          `the Slicer export is a .vp.json with the TF's points (${vp.suggested})`);
+    check(cliRender([volume, '--tf', vp.path, '--size', '48', '--out', join(dir, 'tf-vp.png')]) === 0,
+          'lacuna render --tf reads the exported .vp.json');
+
+    // Upload: another preset first, then each file brings the edited TF back into the editor.
+    const uploaded = async (path) => {
+      await page.selectOption('#preset', 'ct-bone');
+      const n = await page.evaluate(() => window.lacunaViewer.frames());
+      await page.setInputFiles('#tf-file', path);
+      await page.waitForFunction((op) => JSON.stringify(window.lacunaViewer.state.tf.opacity.map((p) => p[1])) === op,
+                                 JSON.stringify(edited.opacity.map((p) => p[1])), { timeout: 30_000 });
+      await waitFullFrame(page, n);
+      return page.evaluate(() => window.lacunaViewer.state.tf);
+    };
+    const fromJson = await uploaded(tfJson.path);
+    check(JSON.stringify(fromJson.opacity) === JSON.stringify(edited.opacity) &&
+          JSON.stringify(fromJson.color) === JSON.stringify(edited.color),
+          'uploading the lacuna JSON gives the editor the same TF');
+    const fromVp = await uploaded(vp.path);
+    const near = (a, b) => a.length === b.length && a.every((p, i) => p.every((v, k) => Math.abs(v - b[i][k]) < 1e-9));
+    check(near(fromVp.opacity, edited.opacity) && near(fromVp.color, edited.color) &&
+          (await page.inputValue('#preset')) === '',
+          'uploading the .vp.json gives the editor the same TF (x through the value domain and back, to 1e-9)');
+
+    // The session and the screenshot of the same view at twice the view's size.
+    await page.selectOption('#shot-scale', '2');
+    const size = (await page.textContent('#shot-size')).split('×').map(Number);
+    const session = await saved('#session-save', 'viewer-session.json');
+    const doc = JSON.parse(readFileSync(session.path, 'utf8'));
+    check(doc.lacuna_session === 1 && doc.volume.path === volume && doc.frame.width === size[0] &&
+          doc.frame.height === size[1] && doc.frame.features.shading === 'phong',
+          `the session names the volume, the size ${size.join('x')} and the toggles (shading ${doc.frame.features.shading})`);
+    const shot = await saved('#screenshot', 'screenshot.png');
+    const png = readFileSync(shot.path);
+    check(png.subarray(1, 4).toString() === 'PNG' && png.readUInt32BE(16) === size[0] && png.readUInt32BE(20) === size[1],
+          `the screenshot is a ${size.join('x')} PNG rendered by the server (${shot.suggested}, ${png.length} bytes)`);
+    const cliPng = join(dir, 'session-cli.png');
+    check(cliRender(['--session', session.path, '--out', cliPng]) === 0, 'lacuna render --session reads the saved session');
+    check(Buffer.compare(readFileSync(cliPng), png) === 0,
+          'lacuna render --session gives the screenshot byte for byte');
+    await page.selectOption('#shot-scale', '1');
   }
 
   // A second tab at the same time.
