@@ -336,14 +336,21 @@ try {
           (await page.inputValue('#preset')) === '',
           'uploading the .vp.json gives the editor the same TF (x through the value domain and back, to 1e-9)');
 
-    // The session and the screenshot of the same view at twice the view's size.
+    // The session and the screenshot of the same view at twice the view's size, with the toggles
+    // on (the slicer switched them off).
+    for (const id of ['shading', 'clip']) {
+      const n = await page.evaluate(() => window.lacunaViewer.frames());
+      await page.check('#' + id);
+      await waitFullFrame(page, n);
+    }
     await page.selectOption('#shot-scale', '2');
     const size = (await page.textContent('#shot-size')).split('×').map(Number);
     const session = await saved('#session-save', 'viewer-session.json');
     const doc = JSON.parse(readFileSync(session.path, 'utf8'));
     check(doc.lacuna_session === 1 && doc.volume.path === volume && doc.frame.width === size[0] &&
-          doc.frame.height === size[1] && doc.frame.features.shading === 'phong',
-          `the session names the volume, the size ${size.join('x')} and the toggles (shading ${doc.frame.features.shading})`);
+          doc.frame.height === size[1] && doc.frame.features.shading === 'phong' &&
+          doc.frame.features.clip_planes.length === 1,
+          `the session names the volume, the size ${size.join('x')} and the toggles (shading ${doc.frame.features.shading}, ${doc.frame.features.clip_planes.length} clip plane)`);
     const shot = await saved('#screenshot', 'screenshot.png');
     const png = readFileSync(shot.path);
     check(png.subarray(1, 4).toString() === 'PNG' && png.readUInt32BE(16) === size[0] && png.readUInt32BE(20) === size[1],
