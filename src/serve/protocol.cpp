@@ -458,6 +458,8 @@ TfImportRequest parse_tf_import_request(std::string_view text, const Limits& lim
     for (char c : r.name)
         if (static_cast<unsigned char>(c) < 0x20) reject("name", "expected a file name without control characters");
     r.text = text_of(j, "text", "");
+    // The file is JSON for two of its three readers: bounded in nesting as a message is.
+    check_shape(r.text, limits);
     return r;
 }
 

@@ -148,6 +148,8 @@ TEST(SavingProtocol, ErrorsNameTheField) {
         {{{"type", "tf_import"}, {"id", 1}, {"name", std::string(300, 'a')}, {"text", "{}"}}, "name:"},
         {{{"type", "tf_import"}, {"id", 1}, {"name", "a\nb"}, {"text", "{}"}}, "name:"},
         {{{"type", "tf_import"}, {"id", 1}, {"name", "a"}, {"text", "{}"}, {"path", "/"}}, "path:"},
+        {{{"type", "tf_import"}, {"id", 1}, {"name", "a.json"}, {"text", std::string(40, '[') + std::string(40, ']')}},
+         "nesting:"},
     };
     for (const auto& [j, needle] : files) {
         const std::string e = error_of([&] {
