@@ -151,14 +151,15 @@ TEST(SavingProtocol, ErrorsNameTheField) {
         {{{"type", "tf_import"}, {"id", 1}, {"name", "a.json"}, {"text", std::string(40, '[') + std::string(40, ']')}},
          "nesting:"},
     };
-    for (const auto& [j, needle] : files) {
+    for (const auto& file : files) {  // (not a structured binding: clang's C++20 lambdas)
+        const json& j = file.first;
         const std::string e = error_of([&] {
             if (j["type"] == "tf_export")
                 parse_tf_export_request(j.dump());
             else
                 parse_tf_import_request(j.dump());
         });
-        EXPECT_NE(e.find(needle), std::string::npos) << j.dump() << ": " << e;
+        EXPECT_NE(e.find(file.second), std::string::npos) << j.dump() << ": " << e;
         EXPECT_EQ(e.find('\n'), std::string::npos) << e;
     }
     // An unknown type names every type the server answers.
@@ -267,9 +268,10 @@ TEST(TfFiles, UploadsAreReadByTheLibrarysReaders) {
         {{"b.vp.json", "{\"volumeProperties\": []}"}, "b.vp.json: volumeProperties"},
         {{"c.vp", "1\n2\n"}, "c.vp: lines"},
     };
-    for (const auto& [file, needle] : bad) {
+    for (const auto& b : bad) {
+        const auto& file = b.first;
         const std::string e = error_of([&] { read_tf_file(file.first, file.second); });
-        EXPECT_NE(e.find(needle), std::string::npos) << file.first << ": " << e;
+        EXPECT_NE(e.find(b.second), std::string::npos) << file.first << ": " << e;
         EXPECT_EQ(e.find('\n'), std::string::npos) << e;
     }
     // Two properties: which one is not guessed.
