@@ -336,6 +336,19 @@ try {
           (await page.inputValue('#preset')) === '',
           'uploading the .vp.json gives the editor the same TF (x through the value domain and back, to 1e-9)');
 
+    // A broken upload: the status line names the file and the field, the editor keeps its TF.
+    {
+      const bad = join(dir, 'broken.vp.json');
+      writeFileSync(bad, JSON.stringify({ volumeProperties: [{ components: [{ scalarOpacity: { points: [] } }] }] }));
+      const kept = await page.evaluate(() => JSON.stringify(window.lacunaViewer.state.tf));
+      await page.setInputFiles('#tf-file', bad);
+      await page.waitForFunction(() => document.getElementById('status').textContent.includes('broken.vp.json'),
+                                 null, { timeout: 30_000 });
+      const status = await page.textContent('#status');
+      check(status.includes('scalarOpacity') && kept === await page.evaluate(() => JSON.stringify(window.lacunaViewer.state.tf)),
+            `a broken upload is one error in the status line, the TF stays ("${status}")`);
+    }
+
     // The session and the screenshot of the same view at twice the view's size, with the toggles
     // on (the slicer switched them off).
     for (const id of ['shading', 'clip']) {
