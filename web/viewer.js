@@ -92,6 +92,7 @@
     if (msg.type === 'hello') return onHello(msg);
     if (msg.type === 'probe') return onProbe(msg);
     if (msg.type === 'session' || msg.type === 'tf_export' || msg.type === 'tf_import') return onFile(msg);
+    if (msg.type === 'session_import') return onSessionOpened(msg);
     if (msg.type === 'error') {
       // The server rejected a request: show it (not a console error: the page stays usable).
       setStatus('server: ' + msg.message);
@@ -124,6 +125,7 @@
     presets.value = msg.presets[msg.tf.name] ? msg.tf.name : '';
     // Session files name the server's volume file (a server without one cannot write them).
     $('session-save').disabled = !msg.session;
+    $('session-open').disabled = !msg.session;
     showShotSize();
     setStatus('');
     request(false);
@@ -205,7 +207,9 @@
   const safeName = (name) => (name || '').replace(/[^A-Za-z0-9._-]+/g, '-').replace(/^[-.]+/, '') || 'tf';
   // The screenshot's (and the session's) size: the view's times the menu's factor, both sides
   // scaled alike and kept within max_side.
+  let sessionSize = null;  // the size of the session opened last (the image size menu's "session")
   function shotSize() {
+    if ($('shot-scale').value === 'session' && sessionSize) return sessionSize.slice();
     const [w, h] = viewSize(), max = hello ? hello.limits.max_side : 2048;
     const k = Math.min(Number($('shot-scale').value) || 1, max / w, max / h);
     return [Math.max(1, Math.round(w * k)), Math.max(1, Math.round(h * k))];
@@ -270,6 +274,55 @@
     $('screenshot').disabled = true;
     setStatus(`rendering a ${size.join('×')} screenshot…`);
   });
+  // Opening a session: the server answers the view state that renders its frame exactly (or an
+  // error naming what the page cannot reproduce); the page takes it over as if the user had set
+  // it, and its size becomes the image size menu's "session" entry.
+  $('session-open').addEventListener('click', () => $('session-file').click());
+  $('session-file').addEventListener('change', async (e) => {
+    const file = e.target.files[0];
+    e.target.value = '';
+    if (!file) return;
+    const text = await file.text();
+    sendFileRequest({ type: 'session_import', id: nextId++, name: file.name, text }, file.name);
+  });
+  function onSessionOpened(msg) {
+    const name = fileRequests.get(msg.id);
+    fileRequests.delete(msg.id);
+    const v = msg.view;
+    state.camera = v.camera;
+    $('view-name').value = v.camera.view || '';
+    state.renderer = v.renderer;
+    $('renderer').value = v.renderer;
+    state.accel = v.accel;
+    $('accel').value = v.accel;
+    state.ert = v.ert;
+    $('ert').checked = v.ert;
+    state.step = v.step;
+    $('step').value = String(v.step);
+    $('step-value').textContent = String(v.step);
+    state.shading = v.shading;
+    $('shading').checked = v.shading;
+    state.clip = v.clip;
+    $('clip').checked = v.clip;
+    state.clipPlanes = v.clip_planes;
+    $('clip-planes').value = v.clip_planes.map((p) => p.join(',')).join('; ');
+    $('clip-planes').classList.remove('invalid');
+    noSegments();
+    setTf(v.tf);
+    $('preset').value = '';
+    sessionSize = [v.width, v.height];
+    let opt = $('shot-scale').querySelector('option[value="session"]');
+    if (!opt) {
+      opt = document.createElement('option');
+      opt.value = 'session';
+      $('shot-scale').appendChild(opt);
+    }
+    opt.textContent = `session (${v.width}×${v.height})`;
+    $('shot-scale').value = 'session';
+    showShotSize();
+    setStatus(`opened ${name}`);
+    request(false);
+  }
   $('session-save').addEventListener('click', () => {
     const id = nextId++;
     sendFileRequest(viewState('session', id, shotSize()), 'lacuna-session.json');

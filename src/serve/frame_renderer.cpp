@@ -121,6 +121,47 @@ FrameSpec FrameRenderer::frame_spec(const ViewRequest& req, int width, int heigh
     return f;
 }
 
+ViewRequest FrameRenderer::view_request(const FrameSpec& f, const TransferFunction& tf) const {
+    if (f.renderer == Renderer::Segments)
+        throw Error("session", "frame.renderer",
+                    "the segment renderer's sessions cannot be opened in the viewer yet (a session "
+                    "file does not hold the label map)");
+    ViewRequest r;
+    r.renderer = f.renderer == Renderer::Slicer ? RendererKind::Slice : RendererKind::March;
+    const std::optional<AccelKind> kind = accel_kind(f.structure);
+    std::string names;
+    bool listed = false;
+    for (const std::string& n : accel_names()) {
+        names += (names.empty() ? "" : ", ") + n;
+        listed = listed || (kind && n == to_string(*kind));
+    }
+    if (!listed)
+        throw Error("session", "frame.structure",
+                    "'" + structure_name(f.structure) + "' is not one of the viewer's structures (" +
+                        names + ")");
+    r.accel = *kind;
+    r.ert = f.sampling.early_termination.has_value();
+    r.step = f.sampling.step;
+    r.shading = f.features.shading == ShadingModel::Phong;
+    // The clip toggle is the first plane when it is the toggle's own (see frame_spec()).
+    r.clip_planes = f.features.clip_planes;
+    const ClipPlane& first = r.clip_planes.empty() ? ClipPlane{} : r.clip_planes.front();
+    if (!r.clip_planes.empty() && first.normal == Vec3f{-1.f, 0.f, 0.f} &&
+        first.d == -m_session->bounds().center().x) {
+        r.clip = true;
+        r.clip_planes.erase(r.clip_planes.begin());
+    }
+    r.camera.azimuth = f.camera.orbit.azimuth_deg;
+    r.camera.elevation = f.camera.orbit.elevation_deg;
+    r.camera.zoom = f.camera.orbit.zoom;
+    r.camera.pan_x = f.camera.pan_x;
+    r.camera.pan_y = f.camera.pan_y;
+    r.width = f.width;
+    r.height = f.height;
+    r.tf = tf;
+    return r;
+}
+
 void FrameRenderer::refine() { m_session->refine(); }
 
 Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {

@@ -72,6 +72,12 @@ class FrameRenderer {
 
     // The frame a request describes, at width x height.
     FrameSpec frame_spec(const ViewRequest& req, int width, int height) const;
+    // The other way (a session file opened in the page): the request whose frame_spec() is
+    // `f` when the page can express it, its size f.width x f.height, its TF `tf`. Throws
+    // lacuna::Error("session", "frame.<field>", ...) for what the page has no control for (the
+    // segment renderer, a structure outside accel_names()); the caller compares frame_spec()
+    // of the result with `f` for everything else (a field the mapping does not carry differs).
+    ViewRequest view_request(const FrameSpec& f, const TransferFunction& tf) const;
 
   private:
     std::unique_ptr<Session> m_session;

@@ -154,7 +154,7 @@ constexpr std::pair<MessageKind, const char*> kMessageNames[] = {
     {MessageKind::Render, "render"},         {MessageKind::Slice, "slice"},
     {MessageKind::Probe, "probe"},           {MessageKind::Screenshot, "screenshot"},
     {MessageKind::Session, "session"},       {MessageKind::TfExport, "tf_export"},
-    {MessageKind::TfImport, "tf_import"}};
+    {MessageKind::TfImport, "tf_import"},    {MessageKind::SessionImport, "session_import"}};
 
 const char* message_name(MessageKind k) {
     for (const auto& [kind, name] : kMessageNames)
@@ -447,9 +447,12 @@ TfExportRequest parse_tf_export_request(std::string_view text, const Limits& lim
     return r;
 }
 
-TfImportRequest parse_tf_import_request(std::string_view text, const Limits& limits) {
+namespace {
+
+// tf_import and session_import: a file's name and text.
+TfImportRequest parse_file_request(std::string_view text, const Limits& limits, const char* type) {
     const json j = parse_json(text, limits);
-    if (text_of(j, "type", "") != "tf_import") reject("type", "expected tf_import");
+    if (text_of(j, "type", "") != type) reject("type", std::string("expected ") + type);
     only_keys(j, {"type", "id", "name", "text"}, "");
     TfImportRequest r;
     r.id = id_of(j);
@@ -458,9 +461,46 @@ TfImportRequest parse_tf_import_request(std::string_view text, const Limits& lim
     for (char c : r.name)
         if (static_cast<unsigned char>(c) < 0x20) reject("name", "expected a file name without control characters");
     r.text = text_of(j, "text", "");
-    // The file is JSON for two of its three readers: bounded in nesting as a message is.
+    // The file is JSON (but for a Slicer .vp): bounded in nesting as a message is.
     check_shape(r.text, limits);
     return r;
+}
+
+}  // namespace
+
+TfImportRequest parse_tf_import_request(std::string_view text, const Limits& limits) {
+    return parse_file_request(text, limits, "tf_import");
+}
+
+TfImportRequest parse_session_import_request(std::string_view text, const Limits& limits) {
+    return parse_file_request(text, limits, "session_import");
+}
+
+std::string session_import_message(uint64_t id, const ViewRequest& v) {
+    json camera{{"zoom", v.camera.zoom}, {"pan", {v.camera.pan_x, v.camera.pan_y}}};
+    // A named view's angles go by name (superior and inferior are +-90, beyond free angles).
+    std::string view;
+    for (const char* name : {"anterior", "posterior", "left", "right", "superior", "inferior"}) {
+        float az = 0, el = 0;
+        if (view.empty() && named_view(name, az, el) && az == v.camera.azimuth && el == v.camera.elevation)
+            view = name;
+    }
+    if (!view.empty()) {
+        camera["view"] = view;
+    } else {
+        camera["azimuth"] = v.camera.azimuth;
+        camera["elevation"] = v.camera.elevation;
+    }
+    json planes = json::array();
+    for (const ClipPlane& p : v.clip_planes)
+        planes.push_back({p.normal.x, p.normal.y, p.normal.z, p.d});
+    json state{{"width", v.width},       {"height", v.height},   {"camera", camera},
+               {"renderer", to_string(v.renderer)}, {"accel", to_string(v.accel)},
+               {"ert", v.ert},           {"step", v.step},       {"shading", v.shading},
+               {"clip", v.clip},         {"clip_planes", planes},
+               {"tf", json::parse(to_json(v.tf))}};
+    return json{{"type", "session_import"}, {"id", id}, {"view", state}}.dump(
+        -1, ' ', false, json::error_handler_t::replace);
 }
 
 Renderer frame_renderer(RendererKind renderer, bool segments) {

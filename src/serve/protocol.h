@@ -29,6 +29,9 @@
 //    (lacuna TF JSON or Slicer .vp.json, serve/tf_files.h).
 //   {"type":"tf_import", "id":N, "name":"file name", "text":"..."}: an uploaded TF file (lacuna
 //    JSON, Slicer .vp.json or .vp), answered with the TF as lacuna TF JSON.
+//   {"type":"session_import", "id":N, "name":"...", "text":"..."}: a session file to open: answered
+//    with the view state that renders its frame exactly, or an error naming the first field the
+//    viewer cannot reproduce (another volume, a feature the page has no control for).
 //   Unknown types, unknown or missing keys, wrong types and out-of-range values are rejected
 //   with an "error" message naming the field; the connection stays open.
 // Server -> page:
@@ -55,6 +58,7 @@
 //   text   {"type":"session", "id", "text":"...the session file..."}
 //   text   {"type":"tf_export", "id", "format", "text":"...the file..."}
 //   text   {"type":"tf_import", "id", "tf":{...lacuna TF JSON...}}
+//   text   {"type":"session_import", "id", "view":{"width", "height", "camera", "renderer", ...}}
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -130,7 +134,7 @@ struct ProbeRequest {
 };
 
 // The kinds of message the page sends, by "type".
-enum class MessageKind { Render, Slice, Probe, Screenshot, Session, TfExport, TfImport };
+enum class MessageKind { Render, Slice, Probe, Screenshot, Session, TfExport, TfImport, SessionImport };
 // The message's "type" (throws lacuna::Error("message", "type"/"json"/..., ...) like
 // parse_request for a type not in message_names()).
 MessageKind message_kind(std::string_view text, const Limits& limits = {});
@@ -168,6 +172,9 @@ struct TfImportRequest {
 };
 TfExportRequest parse_tf_export_request(std::string_view text, const Limits& limits = {});
 TfImportRequest parse_tf_import_request(std::string_view text, const Limits& limits = {});
+// "session_import": a session file to open in the page ({"type", "id", "name", "text"}, the
+// fields of tf_import).
+TfImportRequest parse_session_import_request(std::string_view text, const Limits& limits = {});
 
 // Best effort: the "id" of a rejected message, to echo in the error (nullopt if none).
 std::optional<uint64_t> request_id(std::string_view text, const Limits& limits = {});
@@ -227,6 +234,9 @@ std::string screenshot_message(const ScreenshotInfo& s, std::string_view png);
 std::string session_message(uint64_t id, const std::string& session_text);
 std::string tf_export_message(uint64_t id, TfFileFormat format, const std::string& file_text);
 std::string tf_import_message(uint64_t id, const TransferFunction& tf);
+// The answer to session_import: the view state (the keys of a render message but type, id and
+// preview; the camera by "view" name when its angles are a named view's) the page takes over.
+std::string session_import_message(uint64_t id, const ViewRequest& view);
 
 std::string error_message(const std::string& message, std::optional<uint64_t> id);
 

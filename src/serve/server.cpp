@@ -19,6 +19,8 @@
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -64,6 +66,32 @@ std::string host_name(std::string_view host_header) {
 std::string cost_key(const ViewRequest& r) {
     return to_string(r.renderer) + "/" + to_string(r.accel) + (r.shading ? "/shading" : "") +
            (r.clip ? "/clip" : "") + (r.segments ? "/segments" : "");
+}
+
+// The first field where two session documents differ ("frame.camera.fov_y_deg"), "" if none.
+std::string first_difference(const nlohmann::json& a, const nlohmann::json& b, const std::string& path) {
+    if (a.is_object() && b.is_object()) {
+        for (const auto* side : {&a, &b})
+            for (auto it = side->begin(); it != side->end(); ++it) {
+                const std::string child = path.empty() ? it.key() : path + "." + it.key();
+                if (!a.contains(it.key()) || !b.contains(it.key())) return child;
+                const std::string d = first_difference(a.at(it.key()), b.at(it.key()), child);
+                if (!d.empty()) return d;
+            }
+        return "";
+    }
+    return a == b ? "" : path;
+}
+
+// A session's volume path names the server's file: the same path, or (relative: the page does not
+// know the session file's folder) the server's path ends with it, component by component.
+bool same_volume_path(const std::string& session_path, const std::string& server_path) {
+    namespace fs = std::filesystem;
+    const fs::path a = fs::path(session_path).lexically_normal(), b = fs::path(server_path).lexically_normal();
+    if (a.is_absolute()) return a == b;
+    std::vector<fs::path> ca(a.begin(), a.end()), cb(b.begin(), b.end());
+    if (ca.empty() || ca.size() > cb.size()) return false;
+    return std::equal(ca.rbegin(), ca.rend(), cb.rbegin());
 }
 
 bool is_loopback_name(const std::string& h) {
@@ -328,6 +356,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
                                                    : to_json(req.tf)));
             return;
         }
+        if (kind == MessageKind::SessionImport) return open_session(text);
         const TfImportRequest req = parse_tf_import_request(text, limits);
         const TransferFunction tf = read_tf_file(req.name, req.text);
         const size_t points = tf.color.size() + tf.opacity.size() + tf.rendering.gradient_opacity.size();
@@ -335,6 +364,49 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             throw Error(req.name, "points", std::to_string(points) + "; the viewer takes at most " +
                                                 std::to_string(limits.max_tf_points));
         send_text(tf_import_message(req.id, tf));
+    }
+
+    // A session file opened in the page: the view state whose frame is the session's exactly, or
+    // an error naming the first field the page cannot reproduce.
+    void open_session(const std::string& text) {
+        using nlohmann::json;
+        const Limits& limits = m_server->options.limits;
+        const FrameRenderer& renderer = m_server->renderer;
+        const TfImportRequest req = parse_session_import_request(text, limits);
+        const std::string where = req.name.empty() ? "session" : req.name;
+        const SessionFile f = parse_session_file(req.text, where);
+        const auto& volume = m_server->options.session_volume;
+        if (!volume || !same_volume_path(f.volume.path, volume->path))
+            throw Error(where, "volume.path",
+                        "'" + f.volume.path + "' is not this server's volume" +
+                            (volume ? " (" + volume->path + ")" : ""));
+        json mine = json::parse(to_json(SessionFile{*volume, f.tf, std::nullopt, f.frame}, where));
+        json theirs = json::parse(to_json(f, where));
+        mine["volume"].erase("path");
+        theirs["volume"].erase("path");
+        if (const std::string d = first_difference(theirs["volume"], mine["volume"], "volume"); !d.empty())
+            throw Error(where, d, "differs from the server's volume (lacuna serve's --frame, --range, --dims/--type)");
+        if (f.tf_back) throw Error(where, "tf_back", "the viewer has no back TF (--tf-back)");
+        const ViewRequest view = renderer.view_request(f.frame, f.tf);
+        // Exact: the view's frame is the session's, field by field.
+        const json want = theirs["frame"];
+        const json got = json::parse(to_json(
+            SessionFile{*volume, f.tf, std::nullopt, renderer.frame_spec(view, view.width, view.height)},
+            where))["frame"];
+        if (const std::string d = first_difference(want, got, "frame"); !d.empty())
+            throw Error(where, d, "the viewer has no control for this value (its frame would differ)");
+        // And the page may send it: the answer's view parses as a render message.
+        const std::string answer = session_import_message(req.id, view);
+        json as_render = json::parse(answer)["view"];
+        as_render["type"] = "render";
+        as_render["id"] = req.id;
+        as_render["preview"] = false;
+        try {
+            (void)parse_request(as_render.dump(), limits);
+        } catch (const Error& e) {
+            throw Error(where, "frame", std::string("the viewer cannot send it: ") + e.what());
+        }
+        send_text(answer);
     }
 
     void finish() {

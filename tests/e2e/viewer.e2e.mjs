@@ -372,6 +372,28 @@ try {
     check(cliRender(['--session', session.path, '--out', cliPng]) === 0, 'lacuna render --session reads the saved session');
     check(Buffer.compare(readFileSync(cliPng), png) === 0,
           'lacuna render --session gives the screenshot byte for byte');
+    // Open the saved session after changing the view: the page takes the session's state back
+    // (camera, toggles, TF, size), and saving again writes the same file.
+    {
+      const n = await page.evaluate(() => window.lacunaViewer.frames());
+      await page.selectOption('#view-name', 'left');
+      await page.uncheck('#shading');
+      await page.selectOption('#preset', 'ct-bone');
+      await page.selectOption('#shot-scale', '1');
+      await waitFullFrame(page, n);
+      const m = await page.evaluate(() => window.lacunaViewer.frames());
+      await page.setInputFiles('#session-file', session.path);
+      await page.waitForFunction(() => window.lacunaViewer.state.shading === true, null, { timeout: 30_000 });
+      await waitFullFrame(page, m);
+      const st = await page.evaluate(() => window.lacunaViewer.state);
+      check(st.camera.view === undefined && st.camera.azimuth === doc.frame.camera.azimuth_deg &&
+            st.clip && (await page.inputValue('#shot-scale')) === 'session' &&
+            JSON.stringify(st.tf.opacity) === JSON.stringify(edited.opacity),
+            `opening the session restores the camera (azimuth ${st.camera.azimuth}), the toggles, the TF and the size`);
+      const again = await saved('#session-save', 'reopened-session.json');
+      check(readFileSync(again.path, 'utf8') === readFileSync(session.path, 'utf8'),
+            'saving the opened session writes the same file');
+    }
     await page.selectOption('#shot-scale', '1');
   }
 

@@ -463,3 +463,65 @@ TEST(SavingServer, ASessionNeedsTheVolumesFile) {
     bool binary = false;
     EXPECT_EQ(split_frame(c.read(binary)).header["type"], "screenshot");
 }
+
+TEST(SavingServer, ASavedSessionOpensToTheSameViewAndForeignOnesNameWhatDiffers) {
+    FileServer server;
+    Client c(server.port);
+    c.read_text();
+    json view = view_json("session", 1);
+    view["camera"] = {{"azimuth", -47.5}, {"elevation", 12.25}, {"zoom", 0.9}, {"pan", {0.2, 0.1}}};
+    view["shading"] = true;
+    view["clip"] = true;
+    view["clip_planes"] = {{1, 0, 0, -2.5}};
+    view["ert"] = false;
+    c.send(view.dump());
+    const std::string saved = c.read_text()["text"];
+    // Open it: the view state the server answers saves to the same file.
+    c.send(json{{"type", "session_import"}, {"id", 2}, {"name", "s.json"}, {"text", saved}}.dump());
+    const json opened = c.read_text();
+    ASSERT_EQ(opened["type"], "session_import") << opened.dump();
+    const json& v = opened["view"];
+    EXPECT_EQ(v["camera"]["azimuth"], -47.5);
+    EXPECT_EQ(v["clip"], true);
+    EXPECT_EQ(v["clip_planes"].size(), 1u);  // the toggle's plane is the toggle again
+    json again = v;
+    again["type"] = "session";
+    again["id"] = 3;
+    c.send(again.dump());
+    EXPECT_EQ(c.read_text()["text"], saved);
+    // A named view comes back by name (superior is 90 degrees: beyond free angles).
+    json superior = view_json("session", 4);
+    superior["camera"] = {{"view", "superior"}, {"zoom", 1}, {"pan", {0, 0}}};
+    c.send(superior.dump());
+    const std::string sup = c.read_text()["text"];
+    c.send(json{{"type", "session_import"}, {"id", 5}, {"name", "sup.json"}, {"text", sup}}.dump());
+    EXPECT_EQ(c.read_text()["view"]["camera"]["view"], "superior");
+
+    // Sessions the viewer cannot reproduce: one error each, naming the field.
+    json doc = json::parse(saved);
+    auto refused = [&](const json& d, const std::string& needle) {
+        c.send(json{{"type", "session_import"}, {"id", 9}, {"name", "x.json"}, {"text", d.dump()}}.dump());
+        const json e = c.read_text();
+        EXPECT_EQ(e["type"], "error") << d.dump();
+        EXPECT_EQ(e["id"], 9);
+        EXPECT_NE(e["message"].get<std::string>().find(needle), std::string::npos) << e.dump();
+    };
+    json other = doc;
+    other["volume"]["path"] = "/elsewhere/other.nrrd";
+    refused(other, "x.json: volume.path");
+    json pbr = doc;
+    pbr["frame"]["features"]["shading"] = "pbr";
+    refused(pbr, "x.json: frame.features.shading");
+    json fov = doc;
+    fov["frame"]["camera"]["fov_y_deg"] = 45.0;
+    refused(fov, "x.json: frame.camera");
+    json range = doc;
+    range["volume"]["range"] = {0, 100};
+    refused(range, "x.json: volume.range");
+    refused(json::parse("{\"lacuna_session\": 1, \"frame\": 3}"), "x.json: ");
+    // A relative path naming the server's file is its volume.
+    json relative = doc;
+    relative["volume"]["path"] = server.volume_path.filename().string();
+    c.send(json{{"type", "session_import"}, {"id", 10}, {"name", "r.json"}, {"text", relative.dump()}}.dump());
+    EXPECT_EQ(c.read_text()["type"], "session_import");
+}
