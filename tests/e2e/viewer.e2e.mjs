@@ -388,7 +388,7 @@ try {
       const st = await page.evaluate(() => window.lacunaViewer.state);
       check(st.camera.view === undefined && st.camera.azimuth === doc.frame.camera.azimuth_deg &&
             st.clip && (await page.inputValue('#shot-scale')) === 'session' &&
-            JSON.stringify(st.tf.opacity) === JSON.stringify(edited.opacity),
+            JSON.stringify(st.tf.opacity) === JSON.stringify(doc.tf.opacity),
             `opening the session restores the camera (azimuth ${st.camera.azimuth}), the toggles, the TF and the size`);
       const again = await saved('#session-save', 'reopened-session.json');
       check(readFileSync(again.path, 'utf8') === readFileSync(session.path, 'utf8'),
