@@ -38,7 +38,8 @@
 //   text   {"type":"hello", ...}    once, on connect: volume, histogram, presets, accels,
 //                                    renderers, capabilities, limits, "messages" (the
 //                                    types the server answers: render, slice, probe,
-//                                    screenshot, session, tf_export, tf_import), "session"
+//                                    screenshot, session, tf_export, tf_import,
+//                                    session_import), "session"
 //                                    (true when the server can write session files) and
 //                                    "slice_views" {"planes", "interpolations"}
 //          "capabilities": {"march": {"accels": [...], "features": [...]}, "slice": {...},
