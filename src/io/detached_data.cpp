@@ -75,6 +75,8 @@ std::vector<std::string> check_nrrd_data_files(const std::string& header, bool a
     std::istringstream words(spec);
     std::vector<std::string> w;
     for (std::string t; words >> t;) w.push_back(t);
+    // trim() keeps form feeds and vertical tabs, which the word split drops.
+    if (w.empty()) throw Error(header, field, "names no data file");
     if (w[0] == "LIST") {
         // The names follow the header, one per line.
         int files = 0;

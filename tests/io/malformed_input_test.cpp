@@ -197,6 +197,18 @@ TEST(IoMalformed, DetachedHeaderWithMissingDataFile) {
     expect_read_error(dir.file("lonely.mhd"), {});
 }
 
+// Found by fuzz_nrrd: a "data file:" value of whitespace that trim() keeps (a form feed)
+// split into no words at all, and the reader indexed the first of them.
+TEST(IoMalformed, NrrdDataFileOfOnlyWhitespaceIsRejected) {
+    ScratchDir dir;
+    const std::string found = "\x01NRRD20at)\ndata file:\x0c";
+    test::write_bytes(dir.file("ff.nhdr"), std::vector<uint8_t>(found.begin(), found.end()));
+    expect_read_error(dir.file("ff.nhdr"), {});
+    test::write_text(dir.file("ff2.nhdr"),
+                     nrrd_header("uint8", "4 4 4", 3, "data file: \x0c\v\n"));
+    expect_read_error(dir.file("ff2.nhdr"), {"data file"});
+}
+
 TEST(IoMalformed, MhaWithShortDataIsRejected) {
     ScratchDir dir;
     std::string text =
