@@ -111,29 +111,37 @@ Partial composite_direct(Comm& comm, const Partial& mine, const std::vector<int>
     return out;
 }
 
+// Step 1 of binary swap and radix-k: with N = P + extras ranks (P a power of two), rank P + s
+// sends its non-empty rectangle to rank s, which composites it in its pair's visibility order
+// (child 0, the low side, is rank s). True on the ranks that sent: they are done.
+static bool fold_extras(Comm& comm, Partial& mine, const Decomposition& d, Vec3f eye, Vec3f dir,
+                 bool orthographic, CompositeStats& st) {
+    const int rank = comm.rank(), p = swap_ranks(comm.size()), extras = comm.size() - p;
+    if (rank >= p) {
+        send_rect(comm, rank - p, kTagFold, mine, nonempty_rect(mine, Rect{0, 0, mine.width, mine.height}), st);
+        return true;
+    }
+    if (rank < extras) {
+        std::vector<float> px;
+        const KdNode& pair = d.nodes[size_t(slot_node(d, rank, rank + 1))];
+        const Rect r = recv_rect(comm, rank + p, kTagFold, px);
+        composite_into(mine, r, px.data(), !low_in_front(pair, eye, dir, orthographic));
+    }
+    return false;
+}
+
 Partial composite_binary_swap(Comm& comm, Partial mine, const Decomposition& d, Vec3f eye,
                               Vec3f dir, bool orthographic, CompositeStats& st) {
     const auto t0 = Clock::now();
     const int n = comm.size(), rank = comm.rank();
-    const int p = swap_ranks(n), extras = n - p;
+    const int p = swap_ranks(n);
     auto done = [&](Partial result) {
         st.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
         return result;
     };
-    const Rect whole{0, 0, mine.width, mine.height};
     // 1. The ranks beyond P fold into their siblings (slot s: ranks s and P + s).
-    if (rank >= p) {
-        send_rect(comm, rank - p, kTagFold, mine, nonempty_rect(mine, whole), st);
-        return done(Partial{});
-    }
+    if (fold_extras(comm, mine, d, eye, dir, orthographic, st)) return done(Partial{});
     std::vector<float> px;
-    if (rank < extras) {
-        const KdNode& pair = d.nodes[size_t(slot_node(d, rank, rank + 1))];
-        // Child 0 (low) is rank `rank`, child 1 rank P + rank.
-        const bool mine_front = low_in_front(pair, eye, dir, orthographic);
-        const Rect r = recv_rect(comm, rank + p, kTagFold, px);
-        composite_into(mine, r, px.data(), !mine_front);
-    }
     // 2. log2 P rounds over rows: the lower slot of a pair keeps the upper rows of the region.
     int r0 = 0, r1 = mine.height;
     for (int bit = 1; bit < p; bit *= 2) {
@@ -193,23 +201,14 @@ Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3
                           bool orthographic, int k, CompositeStats& st) {
     const auto t0 = Clock::now();
     const int n = comm.size(), rank = comm.rank();
-    const int p = swap_ranks(n), extras = n - p;
+    const int p = swap_ranks(n);
     auto done = [&](Partial result) {
         st.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
         return result;
     };
-    const Rect whole{0, 0, mine.width, mine.height};
-    // 1. The ranks beyond P fold into their siblings, as in binary swap.
-    if (rank >= p) {
-        send_rect(comm, rank - p, kTagFold, mine, nonempty_rect(mine, whole), st);
-        return done(Partial{});
-    }
+    // 1. The ranks beyond P fold into their siblings as in binary swap.
+    if (fold_extras(comm, mine, d, eye, dir, orthographic, st)) return done(Partial{});
     std::vector<float> px;
-    if (rank < extras) {
-        const KdNode& pair = d.nodes[size_t(slot_node(d, rank, rank + 1))];
-        const Rect r = recv_rect(comm, rank + p, kTagFold, px);
-        composite_into(mine, r, px.data(), !low_in_front(pair, eye, dir, orthographic));
-    }
     // 2. Rounds of g ranks: the slots of an aligned block of unit * g slots that differ only in
     // their digit (slot / unit) % g; the part of the rows a rank keeps is its digit's.
     int r0 = 0, r1 = mine.height;

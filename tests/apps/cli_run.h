@@ -33,16 +33,20 @@ inline std::filesystem::path cli_temp_dir(const std::string& tag) {
     return d;
 }
 
-inline CliResult run_cli(const std::string& args, const std::filesystem::path& dir) {
+// One shell command line (its output captured in files of `dir`).
+inline CliResult run_command(const std::string& command, const std::filesystem::path& dir) {
     const std::filesystem::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + args + " >" + out.string() +
-                            " 2>" + err.string() + " </dev/null";
+    const std::string cmd = command + " >" + out.string() + " 2>" + err.string() + " </dev/null";
     const int status = std::system(cmd.c_str());
     CliResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp_file(out);
     r.err = slurp_file(err);
     return r;
+}
+
+inline CliResult run_cli(const std::string& args, const std::filesystem::path& dir) {
+    return run_command(std::string(LACUNA_CLI_PATH) + " " + args, dir);
 }
 
 // Exit code 2 and exactly one line on stderr that contains `needle`.

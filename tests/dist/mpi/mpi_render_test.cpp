@@ -26,16 +26,9 @@ const fs::path& dir() {
 // mpirun with what this machine needs: more ranks than cores, root in containers.
 CliResult run_mpi(int ranks, const std::string& args) {
     const std::string root = ::geteuid() == 0 ? " --allow-run-as-root" : "";
-    const fs::path out = dir() / "mpi_stdout.txt", err = dir() / "mpi_stderr.txt";
-    const std::string cmd = std::string(LACUNA_MPIEXEC) + root + " --oversubscribe -np " +
-                            std::to_string(ranks) + " " + LACUNA_CLI_PATH + " " + args + " >" +
-                            out.string() + " 2>" + err.string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    CliResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp_file(out);
-    r.err = slurp_file(err);
-    return r;
+    return run_command(std::string(LACUNA_MPIEXEC) + root + " --oversubscribe -np " +
+                           std::to_string(ranks) + " " + LACUNA_CLI_PATH + " " + args,
+                       dir());
 }
 
 // Within 1 of 255 everywhere, identical on >= 99% of the pixels; returns the differing pixels.
