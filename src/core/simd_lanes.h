@@ -80,7 +80,7 @@ Isa active_isa();
 void set_isa(Isa i);
 int lanes_of(Isa i);
 
-inline constexpr int kMaxLanes = 16;
+inline constexpr int kMaxLanes = 32;  // two groups of sixteen (march_lanes16)
 
 struct Lanes {
     alignas(64) float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes];
@@ -796,7 +796,7 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
 LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& g, __m512 x, __m512 y,
                                                            __m512 z, __mmask16 valid, __m512 inv_dt,
                                                            const LeapInverse& li, __mmask16& taken,
-                                                           __m512i& adv) {
+                                                           __m512i& adv, int b = 0) {
     const __m512 zero = _mm512_setzero_ps();
     const __m512i ione = _mm512_set1_epi32(1);
     const __m512 q[3] = {x, y, z};
@@ -806,7 +806,7 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
     const __m512i idx = _mm512_add_epi32(
         _mm512_add_epi32(_mm512_mullo_epi32(_mm512_srli_epi32(c[2], 2), _mm512_set1_epi32(g.leap_sz)),
                          _mm512_mullo_epi32(_mm512_srli_epi32(c[1], 2), _mm512_set1_epi32(g.leap_sy))),
-        _mm512_add_epi32(_mm512_srli_epi32(c[0], 2), _mm512_load_si512(li.octant)));
+        _mm512_add_epi32(_mm512_srli_epi32(c[0], 2), _mm512_load_si512(li.octant + b)));
     const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 2);
     const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
     const __m512i two = _mm512_set1_epi32(2);
@@ -825,7 +825,7 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
     const __m512i lo = _mm512_mask_blend_epi32(coarse, _mm512_set1_epi32(~1), _mm512_set1_epi32(~3));
     __m512 exit_t = _mm512_set1_ps(16777216.f);
     for (int a = 0; a < 3; ++a) {
-        const __m512 inv = _mm512_load_ps(li.inv[a]);
+        const __m512 inv = _mm512_load_ps(li.inv[a] + b);
         const __m512i ahead = _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), fwd, back);
         const __m512 face = _mm512_cvtepi32_ps(_mm512_add_epi32(_mm512_and_si512(c[a], lo), ahead));
         exit_t = _mm512_min_ps(exit_t, _mm512_mul_ps(_mm512_sub_ps(face, q[a]), inv));
@@ -837,16 +837,17 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
 }
 // leap_inverse8's clamped 1 / dir, sixteen lanes.
 LACUNA_AVX512 inline __attribute__((always_inline)) void leap_inverse16(__m512 dx, __m512 dy, __m512 dz,
-                                                                   int32_t stride, LeapInverse& li) {
+                                                                   int32_t stride, LeapInverse& li,
+                                                                   int b = 0) {
     const __m512 big = _mm512_set1_ps(1e30f), nbig = _mm512_set1_ps(-1e30f), one = _mm512_set1_ps(1.f);
     const __m512 d[3] = {dx, dy, dz};
     __m512i oct = _mm512_setzero_si512();
     for (int a = 0; a < 3; ++a) {
         const __m512 inv = _mm512_max_ps(nbig, _mm512_min_ps(big, _mm512_div_ps(one, d[a])));
-        _mm512_store_ps(li.inv[a], inv);
+        _mm512_store_ps(li.inv[a] + b, inv);
         oct = _mm512_or_si512(oct, _mm512_slli_epi32(_mm512_srli_epi32(_mm512_castps_si512(inv), 31), unsigned(a)));
     }
-    _mm512_store_si512(li.octant, _mm512_mullo_epi32(oct, _mm512_set1_epi32(stride)));
+    _mm512_store_si512(li.octant + b, _mm512_mullo_epi32(oct, _mm512_set1_epi32(stride)));
 }
 
 // prefetch_ahead8 for sixteen lanes.
@@ -875,55 +876,69 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void prefetch_ahead16(
     }
 }
 
-template <bool kNearest, class T, class Refill, bool kLeap = false>
-LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
-                                Refill& refill) {
-    static_assert(!(kLeap && kNearest), "leaping is for trilinear samples");
-    const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
-    const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
-    const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
-                 vhi2 = _mm512_set1_ps(g.hi[2]);
-    const __m512i vsy = _mm512_set1_epi32(g.sy), vsz = _mm512_set1_epi32(g.sz);
-    const __m512 voff = _mm512_set1_ps(g.lut_offset), vscale = _mm512_set1_ps(g.lut_scale),
-                 vlast = _mm512_set1_ps(g.lut_last);
-    const __m512i vzero_entry = _mm512_set1_epi32(g.zero_entry), ione = _mm512_set1_epi32(1);
+// Sixteen lanes, in kGroups groups of sixteen (Lanes holds 16 kGroups rays).
+//
+// Why two groups. A leaping lane's step is one dependency chain: k gives the sample's position,
+// the position the leap-map entry (a gather), the entry the leap, the leap the next k. About a
+// hundred cycles of latency, against some forty of throughput work hanging off it (corner
+// loads, LUT loads, compositing); profiles put a quarter of the kernel's time on the instruction
+// after the gather. Two groups of sixteen rays, stepped one after the other in one loop, are
+// two independent chains, and the core overlaps one group's wait with the other's work. Each
+// lane still performs exactly its own ray's operations in its own order, so the bits do not
+// change (nothing is shared between lanes but the loop). The groups refill together: once a
+// quarter of all lanes wait, or every active lane does.
+template <bool kNearest, class T, bool kLeap>
+struct Group16 {
     __m512 ox, oy, oz, dx, dy, dz, tb, ar, ag, ab, aa;
     __m512i kend, k, n;
     __mmask16 active;
-#define LACUNA_LOAD_LANES                                                                   \
-    ox = _mm512_load_ps(s.ox), oy = _mm512_load_ps(s.oy), oz = _mm512_load_ps(s.oz);        \
-    dx = _mm512_load_ps(s.dx), dy = _mm512_load_ps(s.dy), dz = _mm512_load_ps(s.dz);        \
-    tb = _mm512_load_ps(s.t_base);                                                          \
-    kend = _mm512_load_si512(s.kend);                                                       \
-    active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active), _mm512_setzero_si512()); \
-    k = _mm512_load_si512(s.k);                                                             \
-    n = _mm512_load_si512(s.n);                                                             \
-    ar = _mm512_load_ps(s.r), ag = _mm512_load_ps(s.g), ab = _mm512_load_ps(s.b);           \
-    aa = _mm512_load_ps(s.a);                                                               \
-    if constexpr (kLeap) leap_inverse16(dx, dy, dz, g.leap_octant, linv);
-    LeapInverse linv;  // leaping: 1 / dir per lane
-    const __m512 inv_dt = _mm512_set1_ps(1.f / g.dt);
-    int waiting = 0;
-    LACUNA_LOAD_LANES
-    int need;
-    for (;;) {
+
+    LACUNA_AVX512 inline __attribute__((always_inline)) void load(const Lanes& s, int b,
+                                                                  const LaneGrid& g, LeapInverse& li) {
+        ox = _mm512_load_ps(s.ox + b), oy = _mm512_load_ps(s.oy + b), oz = _mm512_load_ps(s.oz + b);
+        dx = _mm512_load_ps(s.dx + b), dy = _mm512_load_ps(s.dy + b), dz = _mm512_load_ps(s.dz + b);
+        tb = _mm512_load_ps(s.t_base + b);
+        kend = _mm512_load_si512(s.kend + b);
+        active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active + b), _mm512_setzero_si512());
+        k = _mm512_load_si512(s.k + b);
+        n = _mm512_load_si512(s.n + b);
+        ar = _mm512_load_ps(s.r + b), ag = _mm512_load_ps(s.g + b), ab = _mm512_load_ps(s.b + b);
+        aa = _mm512_load_ps(s.a + b);
+        if constexpr (kLeap) leap_inverse16(dx, dy, dz, g.leap_octant, li, b);
+    }
+    LACUNA_AVX512 inline __attribute__((always_inline)) void store(Lanes& s, int b) const {
+        _mm512_store_si512(s.kend + b, kend);
+        _mm512_store_si512(s.k + b, k);
+        _mm512_store_si512(s.n + b, n);
+        _mm512_store_ps(s.r + b, ar);
+        _mm512_store_ps(s.g + b, ag);
+        _mm512_store_ps(s.b + b, ab);
+        _mm512_store_ps(s.a + b, aa);
+    }
+    // One sample (or one leap) per valid lane; returns the active lanes whose run is over.
+    LACUNA_AVX512 inline __attribute__((always_inline)) __mmask16 step(const LaneGrid& g, const T* data,
+                                                                       const float* lut,
+                                                                       const LeapInverse& li, int b) {
+        const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
+        const __m512i ione = _mm512_set1_epi32(1);
         const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
         const __m512 t =
-            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), vdt));
+            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), _mm512_set1_ps(g.dt)));
         __m512 x = _mm512_add_ps(ox, _mm512_mul_ps(t, dx));
         __m512 y = _mm512_add_ps(oy, _mm512_mul_ps(t, dy));
         __m512 z = _mm512_add_ps(oz, _mm512_mul_ps(t, dz));
-        x = _mm512_max_ps(zero, _mm512_min_ps(vhi0, x));
-        y = _mm512_max_ps(zero, _mm512_min_ps(vhi1, y));
-        z = _mm512_max_ps(zero, _mm512_min_ps(vhi2, z));
+        x = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), x));
+        y = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), y));
+        z = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), z));
         __m512 v;
         if constexpr (kNearest) {
             const __m512i ni = _mm512_cvttps_epi32(_mm512_add_ps(x, half));
             const __m512i nj = _mm512_cvttps_epi32(_mm512_add_ps(y, half));
             const __m512i nk = _mm512_cvttps_epi32(_mm512_add_ps(z, half));
             const __m512i off = _mm512_maskz_mov_epi32(
-                active, _mm512_add_epi32(
-                            _mm512_add_epi32(_mm512_mullo_epi32(nk, vsz), _mm512_mullo_epi32(nj, vsy)), ni));
+                active, _mm512_add_epi32(_mm512_add_epi32(_mm512_mullo_epi32(nk, _mm512_set1_epi32(g.sz)),
+                                                          _mm512_mullo_epi32(nj, _mm512_set1_epi32(g.sy))),
+                                         ni));
             if constexpr (std::is_same_v<T, float>) {
                 v = _mm512_i32gather_ps(off, reinterpret_cast<const float*>(data), 4);
             } else {
@@ -942,7 +957,7 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         __mmask16 taken = valid;
         __m512i adv = ione;
         if constexpr (kLeap) {
-            leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
+            leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b);
             prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);
             v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(g, data, x, y, z,
                                                                 std::is_integral_v<T> ? taken : active);
@@ -950,9 +965,11 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         // A step on which every lane leaps composites nothing (their entries would be the
         // zero entry, which adds exact zeros): the LUT loads are skipped.
         if (!kLeap || taken) {
-            __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
-            u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
-            const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
+            __m512 u = _mm512_add_ps(
+                _mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)), _mm512_set1_ps(g.lut_scale)), half);
+            u = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.lut_last), u));
+            const __m512i entry =
+                _mm512_mask_blend_epi32(taken, _mm512_set1_epi32(g.zero_entry), _mm512_cvttps_epi32(u));
             // RGBA of the 16 entries: sixteen 16-byte loads and a 4x4 transpose per 128-bit lane
             // (gathers cost ~1.4 cycles per element here; this is ~1.5 shuffles per sample). Lane j
             // of q4[i] holds lane 4j + i's entry, so the transpose leaves the channels in lane order.
@@ -960,10 +977,10 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
             _mm512_store_si512(e, entry);
             __m512 q4[4];
             for (int i = 0; i < 4; ++i) {
-                __m512 v = _mm512_castps128_ps512(_mm_loadu_ps(lut + 4 * ptrdiff_t(e[i])));
-                v = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[4 + i])), 1);
-                v = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[8 + i])), 2);
-                q4[i] = _mm512_insertf32x4(v, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[12 + i])), 3);
+                __m512 r = _mm512_castps128_ps512(_mm_loadu_ps(lut + 4 * ptrdiff_t(e[i])));
+                r = _mm512_insertf32x4(r, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[4 + i])), 1);
+                r = _mm512_insertf32x4(r, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[8 + i])), 2);
+                q4[i] = _mm512_insertf32x4(r, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[12 + i])), 3);
             }
             const __m512 t0 = _mm512_unpacklo_ps(q4[0], q4[1]), t1 = _mm512_unpackhi_ps(q4[0], q4[1]);
             const __m512 t2 = _mm512_unpacklo_ps(q4[2], q4[3]), t3 = _mm512_unpackhi_ps(q4[2], q4[3]);
@@ -983,26 +1000,38 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
         else
             k = _mm512_mask_add_epi32(k, valid, k, ione);
         const __mmask16 over =
-            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, vert, _CMP_GE_OS);
+            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, _mm512_set1_ps(g.ert), _CMP_GE_OS);
+        kend = _mm512_mask_mov_epi32(kend, over, k);  // a waiting lane takes no step
+        return over & active;
+    }
+};
+
+template <bool kNearest, class T, class Refill, bool kLeap = false, int kGroups = 1>
+LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                                Refill& refill) {
+    static_assert(!(kLeap && kNearest), "leaping is for trilinear samples");
+    static_assert(kGroups >= 1 && 16 * kGroups <= kMaxLanes);
+    Group16<kNearest, T, kLeap> G[kGroups];
+    LeapInverse linv;  // leaping: 1 / dir per lane
+    uint32_t active = 0, waiting = 0;
+    for (int i = 0; i < kGroups; ++i) {
+        G[i].load(s, 16 * i, g, linv);
+        active |= uint32_t(G[i].active) << (16 * i);
+    }
+    for (;;) {
+#pragma GCC unroll 2
+        for (int i = 0; i < kGroups; ++i) waiting |= uint32_t(G[i].step(g, data, lut, linv, 16 * i)) << (16 * i);
         // Waiting lanes, as in the AVX2 kernel: refill once a quarter of the lanes wait.
-        kend = _mm512_mask_mov_epi32(kend, over, k);
-        need = int(over & active);
-        waiting |= need;
-        if (__builtin_popcount(unsigned(waiting)) >= 4 || waiting == int(active)) {
-            need = waiting;
-            waiting = 0;
-            _mm512_store_si512(s.kend, kend);
-            _mm512_store_si512(s.k, k);
-            _mm512_store_si512(s.n, n);
-            _mm512_store_ps(s.r, ar);
-            _mm512_store_ps(s.g, ag);
-            _mm512_store_ps(s.b, ab);
-            _mm512_store_ps(s.a, aa);
-            if (!refill(need)) return;
-            LACUNA_LOAD_LANES
+        if (__builtin_popcount(waiting) >= 4 * kGroups || waiting == active) {
+            for (int i = 0; i < kGroups; ++i) G[i].store(s, 16 * i);
+            if (!refill(waiting)) return;
+            waiting = 0, active = 0;
+            for (int i = 0; i < kGroups; ++i) {
+                G[i].load(s, 16 * i, g, linv);
+                active |= uint32_t(G[i].active) << (16 * i);
+            }
         }
     }
-#undef LACUNA_LOAD_LANES
 }
 
 #pragma GCC diagnostic pop

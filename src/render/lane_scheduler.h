@@ -172,7 +172,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
         L.k[l] = L.kend[l] = 0;
     };
     // The lanes that need it: the ray's next run, or its pixel and the tile's next ray.
-    auto refill = [&](int need) {
+    auto refill = [&](uint32_t need) {
         policy.poll();
         for (int l = 0; l < W; ++l) {
             if (!(need >> l & 1)) continue;

@@ -154,14 +154,14 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
     }
 #if LACUNA_SIMD_X86
     // The refined grid on AVX-512 and AVX2: every ray one run, leaping in the lanes
-    // (core/simd_lanes.h).
+    // (core/simd_lanes.h; on AVX-512 two groups of sixteen lanes in flight, Group16).
     if constexpr (std::is_same_v<S, BrickGrid> && !kNearest) {
         static const NoAccel kWholeRay;
         if (isa == simd::Isa::Avx512 && accel.leap_map()) {
-            render_tile_lanes<16>(
+            render_tile_lanes<32>(
                 kWholeRay, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
                 [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l, auto& refill) {
-                    simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true>(
+                    simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true, 2>(
                         L, lg, d, l, refill);
                 },
                 &accel);
