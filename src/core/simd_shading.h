@@ -569,7 +569,7 @@ LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data
 // ShadedStream computes once per ray), and its colour goes into its ray's record by
 // r += w * rgb * a in queue order, which is the ray's sample order. So every pixel has the bits
 // of ShadedStream's, hence of composite_ray's.
-inline constexpr int kShadeRecords = 32;  // rays in flight: the lanes plus the deferred pixels
+inline constexpr int kShadeRecords = 64;  // rays in flight: the lanes (32) plus the deferred pixels
 // Per ray: colour accumulators, the ray's view v, half vector h and |l + v| > 0 (its light l is
 // the frame's: ShadeFrame), and how many of its samples wait in the queue.
 struct ShadeRecords {
@@ -771,64 +771,71 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
 }
 
 
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 // ---- Shading across rays (AVX-512): sixteen lanes ------------------------------------------------
 // march_shaded_lanes8 with march_lanes16's lane set (sixteen rays, trilinear16, leap16): per lane
 // the same operations, so the same bits. The visible samples of a lane set enter the queue by
 // compression in lane order (a ray's samples stay in its sample order: one per lane and
-// iteration), and every full eight is shaded by shade_run8.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-template <class T, class Refill>
-LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
-                                       const ShadeFrame& f, ShadeQueue& q, ShadeRecords& R,
-                                       const int32_t* rec, Refill& refill) {
-    const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
-    const __m512 vdt = _mm512_set1_ps(g.dt), vert = _mm512_set1_ps(g.ert);
-    const __m512 vhi0 = _mm512_set1_ps(g.hi[0]), vhi1 = _mm512_set1_ps(g.hi[1]),
-                 vhi2 = _mm512_set1_ps(g.hi[2]);
-    const __m512 voff = _mm512_set1_ps(g.lut_offset), vscale = _mm512_set1_ps(g.lut_scale),
-                 vlast = _mm512_set1_ps(g.lut_last);
-    const __m512i vzero_entry = _mm512_set1_epi32(g.zero_entry), ione = _mm512_set1_epi32(1);
+// iteration), and every full eight is shaded by shade_run8. Two groups of sixteen lanes are in
+// flight, as in march_lanes16 (simd_lanes.h, Group16: two independent leap chains); a ray's
+// samples still enter the queue in its own order, one per step of its group.
+template <class T>
+struct ShadedGroup16 {
     __m512 ox, oy, oz, dx, dy, dz, tb, aa;
     __m512i kend, k, n, vrec;
     __mmask16 active;
-#define LACUNA_LOAD_LANES                                                                   \
-    ox = _mm512_load_ps(s.ox), oy = _mm512_load_ps(s.oy), oz = _mm512_load_ps(s.oz);        \
-    dx = _mm512_load_ps(s.dx), dy = _mm512_load_ps(s.dy), dz = _mm512_load_ps(s.dz);        \
-    tb = _mm512_load_ps(s.t_base);                                                          \
-    kend = _mm512_load_si512(s.kend);                                                       \
-    active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active), _mm512_setzero_si512()); \
-    k = _mm512_load_si512(s.k);                                                             \
-    n = _mm512_load_si512(s.n);                                                             \
-    aa = _mm512_load_ps(s.a);                                                               \
-    vrec = _mm512_loadu_si512(rec); /* the lanes' records (a refill may change them) */     \
-    leap_inverse16(dx, dy, dz, g.leap_octant, linv);
-    LeapInverse linv;
-    const __m512 inv_dt = _mm512_set1_ps(1.f / g.dt);
-    int waiting = 0;
-    LACUNA_LOAD_LANES
-    int need;
-    for (;;) {
+
+    LACUNA_AVX512 inline __attribute__((always_inline)) void load(const Lanes& s, int b, const LaneGrid& g,
+                                                                  const int32_t* rec, LeapInverse& li) {
+        ox = _mm512_load_ps(s.ox + b), oy = _mm512_load_ps(s.oy + b), oz = _mm512_load_ps(s.oz + b);
+        dx = _mm512_load_ps(s.dx + b), dy = _mm512_load_ps(s.dy + b), dz = _mm512_load_ps(s.dz + b);
+        tb = _mm512_load_ps(s.t_base + b);
+        kend = _mm512_load_si512(s.kend + b);
+        active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active + b), _mm512_setzero_si512());
+        k = _mm512_load_si512(s.k + b);
+        n = _mm512_load_si512(s.n + b);
+        aa = _mm512_load_ps(s.a + b);
+        vrec = _mm512_loadu_si512(rec + b);  // the lanes' records (a refill may change them)
+        leap_inverse16(dx, dy, dz, g.leap_octant, li, b);
+    }
+    LACUNA_AVX512 inline __attribute__((always_inline)) void store(Lanes& s, int b) const {
+        _mm512_store_si512(s.kend + b, kend);
+        _mm512_store_si512(s.k + b, k);
+        _mm512_store_si512(s.n + b, n);
+        _mm512_store_ps(s.a + b, aa);
+    }
+    // One sample (or leap) per valid lane, its visible samples queued; returns the active lanes
+    // whose run is over.
+    LACUNA_AVX512 inline __attribute__((always_inline)) __mmask16 step(const LaneGrid& g, const T* data,
+                                                                       const float* lut, const ShadeFrame& f,
+                                                                       ShadeQueue& q, ShadeRecords& R,
+                                                                       const int32_t* rec,
+                                                                       const LeapInverse& li, int b) {
+        const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
+        const __m512i ione = _mm512_set1_epi32(1);
         const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
         const __m512 t =
-            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), vdt));
+            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), _mm512_set1_ps(g.dt)));
         const __m512 px = _mm512_add_ps(ox, _mm512_mul_ps(t, dx));
         const __m512 py = _mm512_add_ps(oy, _mm512_mul_ps(t, dy));
         const __m512 pz = _mm512_add_ps(oz, _mm512_mul_ps(t, dz));
-        const __m512 x = _mm512_max_ps(zero, _mm512_min_ps(vhi0, px));
-        const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(vhi1, py));
-        const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(vhi2, pz));
+        const __m512 x = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), px));
+        const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), py));
+        const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), pz));
         __mmask16 taken;
         __m512i adv;
-        leap16(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b);
         prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);  // (simd_lanes.h)
         // (only the lanes that take their sample load its corners: trilinear16's kSparse)
         const __m512 v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
             g, data, x, y, z, std::is_integral_v<T> ? taken : active);
-        __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, voff), vscale), half);
-        u = _mm512_max_ps(zero, _mm512_min_ps(vlast, u));
-        const __m512i entry = _mm512_mask_blend_epi32(taken, vzero_entry, _mm512_cvttps_epi32(u));
+        __m512 u = _mm512_add_ps(
+            _mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)), _mm512_set1_ps(g.lut_scale)), half);
+        u = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.lut_last), u));
+        const __m512i entry =
+            _mm512_mask_blend_epi32(taken, _mm512_set1_epi32(g.zero_entry), _mm512_cvttps_epi32(u));
         const __m512 ca = _mm512_i32gather_ps(_mm512_slli_epi32(entry, 2), lut + 3, 4);
         const __m512 w = _mm512_sub_ps(one, aa);
         aa = _mm512_add_ps(aa, _mm512_mul_ps(w, ca));
@@ -844,28 +851,44 @@ LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* da
             _mm512_storeu_si512(q.e + j, _mm512_maskz_compress_epi32(vis, entry));
             _mm512_storeu_si512(q.rec + j, _mm512_maskz_compress_epi32(vis, vrec));
             q.n = j + __builtin_popcount(unsigned(vis));
-            for (unsigned m = vis; m; m &= m - 1) ++R.pending[rec[__builtin_ctz(m)]];
+            for (unsigned m = vis; m; m &= m - 1) ++R.pending[rec[b + __builtin_ctz(m)]];
             if (q.n >= 8) shade_full8(f, data, q, R);
         }
         n = _mm512_mask_add_epi32(n, taken, n, ione);
         k = _mm512_min_epi32(_mm512_mask_add_epi32(k, valid, k, adv), kend);
         const __mmask16 over =
-            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, vert, _CMP_GE_OS);
+            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, _mm512_set1_ps(g.ert), _CMP_GE_OS);
         kend = _mm512_mask_mov_epi32(kend, over, k);
-        need = int(over & active);
-        waiting |= need;
-        if (__builtin_popcount(unsigned(waiting)) >= 4 || waiting == int(active)) {
-            need = waiting;
-            waiting = 0;
-            _mm512_store_si512(s.kend, kend);
-            _mm512_store_si512(s.k, k);
-            _mm512_store_si512(s.n, n);
-            _mm512_store_ps(s.a, aa);
-            if (!refill(need)) return;
-            LACUNA_LOAD_LANES
+        return over & active;
+    }
+};
+
+template <class T, class Refill, int kGroups = 2>
+LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
+                                       const ShadeFrame& f, ShadeQueue& q, ShadeRecords& R,
+                                       const int32_t* rec, Refill& refill) {
+    static_assert(kGroups >= 1 && 16 * kGroups <= kMaxLanes);
+    ShadedGroup16<T> G[kGroups];
+    LeapInverse linv;
+    uint32_t active = 0, waiting = 0;
+    for (int i = 0; i < kGroups; ++i) {
+        G[i].load(s, 16 * i, g, rec, linv);
+        active |= uint32_t(G[i].active) << (16 * i);
+    }
+    for (;;) {
+#pragma GCC unroll 2
+        for (int i = 0; i < kGroups; ++i)
+            waiting |= uint32_t(G[i].step(g, data, lut, f, q, R, rec, linv, 16 * i)) << (16 * i);
+        if (__builtin_popcount(waiting) >= 4 * kGroups || waiting == active) {
+            for (int i = 0; i < kGroups; ++i) G[i].store(s, 16 * i);
+            if (!refill(waiting)) return;
+            waiting = 0, active = 0;
+            for (int i = 0; i < kGroups; ++i) {
+                G[i].load(s, 16 * i, g, rec, linv);
+                active |= uint32_t(G[i].active) << (16 * i);
+            }
         }
     }
-#undef LACUNA_LOAD_LANES
 }
 #pragma GCC diagnostic pop
 

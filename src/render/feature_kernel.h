@@ -870,10 +870,11 @@ void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Vol
     set_leap(lg, grid);
     ShadedLanesPolicy<T> policy(c, sf, data, out, opt);
     const float* lut = &corr_z[0].r;
-    // Every ray one run: the lanes leap (core/simd_lanes.h); sixteen lanes on AVX-512 CPUs.
+    // Every ray one run: the lanes leap (core/simd_lanes.h); on AVX-512 CPUs two groups of
+    // sixteen lanes.
     static const NoAccel kWholeRay;
     if (simd::active_isa() == simd::Isa::Avx512) {
-        schedule_tile_lanes<16>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
+        schedule_tile_lanes<32>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
                                 counts.samples, counts.rays, [&](simd::Lanes& L, auto& refill) {
                                     simd::march_shaded_lanes16<T, std::remove_reference_t<decltype(refill)>>(
                                         L, lg, data, lut, sf, policy.queue(), policy.records(),
