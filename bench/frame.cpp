@@ -1,5 +1,6 @@
 // One frame per skipping structure on the generated tree volume (docs/benchmarks.md); the
-// counters report samples per ray. Frames render through lacuna::Session. `frame --benchmark_filter=Frame`.
+// counters report samples per ray. Frames render through lacuna::Session. `frame
+// --benchmark_filter=Frame`.
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -31,7 +32,8 @@ void Frame(benchmark::State& state) {
     session.set_transfer_function(preset("mr-default"));
     FrameSpec f;
     f.structure = structure_of(kind);
-    f.camera.orbit.azimuth_deg = 210;  // azimuth 30 before issue 14's anatomical azimuth: the same view
+    f.camera.orbit.azimuth_deg =
+        210;  // azimuth 30 before issue 14's anatomical azimuth: the same view
     f.width = f.height = 512;
     if (!state.range(1)) f.sampling.early_termination.reset();
     session.render(f);  // builds the structure

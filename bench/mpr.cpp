@@ -6,6 +6,8 @@
 // before JPEG). Reported: the median of the repetitions, real time, the main thread's CPU time
 // and cpu_ms, the whole process's CPU time per slice (all threads).
 //   mpr --benchmark_repetitions=15 --benchmark_report_aggregates_only=true
+#include "lacuna/mpr.h"
+
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -14,7 +16,6 @@
 
 #include "core/parallel.h"
 #include "lacuna/io.h"
-#include "lacuna/mpr.h"
 #include "lacuna/orientation.h"
 
 namespace {
@@ -58,8 +59,8 @@ void Slice512(benchmark::State& state) {
         const Image img = window_level(s, 100, 50);
         cpu += process_cpu_seconds() - c0;
         benchmark::DoNotOptimize(img.rgba.data());
-        inside = size_t(std::count_if(s.values.begin(), s.values.end(),
-                                      [](float x) { return x == x; }));
+        inside =
+            size_t(std::count_if(s.values.begin(), s.values.end(), [](float x) { return x == x; }));
     }
     state.counters["cpu_ms"] = benchmark::Counter(cpu * 1e3 / double(state.iterations()));
     state.counters["inside"] = double(inside) / (512.0 * 512.0);

@@ -1,12 +1,13 @@
 // Session files (src/session/session_file.h): parse_session_file on arbitrary text. An accepted
 // file must round-trip exactly (to_json, parse, to_json gives the same text) and its frame must
 // pass lacuna::validate (the parser validates; a frame it accepts is one the renderers take).
+#include "session/session_file.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include "fuzz_util.h"
-#include "session/session_file.h"
 
 using namespace lacuna;
 using fuzz::fuzz_check;

@@ -18,7 +18,8 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 int parse_count(const std::string& item, const std::string& where, const std::string& list) {
-    if (item.empty() || item.size() > 6 || item.find_first_not_of("0123456789") != std::string::npos)
+    if (item.empty() || item.size() > 6 ||
+        item.find_first_not_of("0123456789") != std::string::npos)
         throw Error(where, "list", "expected comma-separated integers, got '" + list + "'");
     return std::stoi(item);
 }

@@ -70,10 +70,12 @@ void run_kdtree_bench(const KdBenchArgs& a) {
 
     const std::filesystem::path dir = create_out_dir(a.out_dir);
     bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench kdtree"));
-    std::printf("lacuna bench kdtree: %zu datasets x %zu sizes, %dx%d px, %d views, %s, %d threads\n",
-                o.datasets.size(), o.sizes.size(), o.orbit.size, o.orbit.size, o.orbit.views,
-                info.cpu.c_str(), info.cores);
-    const std::string md_path = (dir / "kdtree.md").string(), csv_path = (dir / "kdtree.csv").string();
+    std::printf(
+        "lacuna bench kdtree: %zu datasets x %zu sizes, %dx%d px, %d views, %s, %d threads\n",
+        o.datasets.size(), o.sizes.size(), o.orbit.size, o.orbit.size, o.orbit.views,
+        info.cpu.c_str(), info.cores);
+    const std::string md_path = (dir / "kdtree.md").string(),
+                      csv_path = (dir / "kdtree.csv").string();
     auto write = [&](const bench::KdBenchReport& rep) {
         info.load_end = bench::current_load();
         bench::write_text_file(md_path, bench::kd_bench_markdown(rep, info));
@@ -87,8 +89,9 @@ void run_kdtree_bench(const KdBenchArgs& a) {
     if (!failures.empty()) {
         std::string list;
         for (const auto& f : failures) list += (list.empty() ? "" : "; ") + f;
-        throw Error("bench kdtree", "exactness",
-                    std::to_string(failures.size()) + " image(s) differ from none (a bug): " + list);
+        throw Error(
+            "bench kdtree", "exactness",
+            std::to_string(failures.size()) + " image(s) differ from none (a bug): " + list);
     }
 }
 
@@ -97,7 +100,8 @@ void run_kdtree_bench(const KdBenchArgs& a) {
 void register_bench_kdtree(CLI::App& bench) {
     auto a = std::make_shared<KdBenchArgs>();
     auto* k = bench.add_subcommand(
-        "kdtree", "The kd-tree paper's measurements: boxes, removed space, steps 1-3, frames per M");
+        "kdtree",
+        "The kd-tree paper's measurements: boxes, removed space, steps 1-3, frames per M");
     k->add_option("--datasets", a->datasets,
                   "Comma-separated: ch2, ch2better, ch2bet, aal, tree (or faludi names)")
         ->capture_default_str();
@@ -127,8 +131,9 @@ void register_bench_kdtree(CLI::App& bench) {
         ->capture_default_str();
     k->add_option("--out-dir", a->out_dir, "Folder for kdtree.md and kdtree.csv")
         ->capture_default_str();
-    k->add_flag("--quick", a->quick,
-                "Tiny run: ch2bet and tree at 24^3 and 40^3, 48 px, 1 view, 1 build (unless given)");
+    k->add_flag(
+        "--quick", a->quick,
+        "Tiny run: ch2bet and tree at 24^3 and 40^3, 48 px, 1 view, 1 build (unless given)");
     k->callback([a, k] {
         KdBenchArgs args = *a;
         if (args.quick) {

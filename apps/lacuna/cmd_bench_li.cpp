@@ -60,7 +60,8 @@ void run_li(const LiArgs& a) {
     for (const std::string& n : split_list(a.datasets)) ids.push_back(bench::parse_dataset(n));
     if (ids.empty()) throw Error("--datasets", "datasets", "expected at least one");
     const std::filesystem::path dir = create_out_dir(a.out_dir);
-    bench::RunInfo info = bench::collect_run_info(command_line("lacuna bench li", ArgQuoting::Plain));
+    bench::RunInfo info =
+        bench::collect_run_info(command_line("lacuna bench li", ArgQuoting::Plain));
     std::printf("lacuna bench li: %dx%d, %d views, %zu datasets, ESS = %s, %s, %d threads\n",
                 a.size, a.size, a.views, ids.size(), a.ess.c_str(), info.cpu.c_str(), info.cores);
     bench::DatasetSource src;
@@ -82,7 +83,8 @@ void run_li(const LiArgs& a) {
                 dir.c_str());
     for (const auto& d : rep.datasets)
         if (!d.ess_exact || !d.map_only_exact)
-            throw Error("bench li", "exactness", d.name + ": ESS or ESS+M differs from Basic (a bug)");
+            throw Error("bench li", "exactness",
+                        d.name + ": ESS or ESS+M differs from Basic (a bug)");
 }
 
 }  // namespace
@@ -107,7 +109,8 @@ void register_bench_li(CLI::App& bench) {
                   "ESS boxes: largest joined box, per axis in world units (mm)")
         ->capture_default_str();
     c->add_option("--step", a->step, "Slice distance in voxels")->capture_default_str();
-    c->add_option("--threshold", a->threshold, "Occlusion opacity threshold")->capture_default_str();
+    c->add_option("--threshold", a->threshold, "Occlusion opacity threshold")
+        ->capture_default_str();
     c->add_option("--map", a->map, "Opacity map edge in cells")->capture_default_str();
     c->add_option("--updates", a->updates, "Initial desired map updates per frame (k)")
         ->capture_default_str();

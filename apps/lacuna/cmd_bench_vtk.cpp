@@ -33,7 +33,7 @@ struct VtkArgs {
     std::string shading = "none,phong";
     int rounds = 3, frames = 3, threads = 2, tree_size = 512;
     float step = 0.5f, azimuth = 20.f, elevation = 15.f;  // the face, slightly from the left
-    std::string accel;  // empty: lacuna render's default
+    std::string accel;                                    // empty: lacuna render's default
     std::string out_dir = "out/bench-vtk";
     std::string templates = "/usr/share/mricron/templates";
     bool quick = false;

@@ -42,7 +42,8 @@ void register_generate(CLI::App& app) {
     cmd->add_option("--dims", a->dims, "Dimensions AxBxC")->capture_default_str();
     cmd->add_option("--type", a->type, "uint8, int16, uint16 or float32")->capture_default_str();
     cmd->add_option("--seed", a->seed, "Random seed")->capture_default_str();
-    cmd->add_option("--out,-o", a->out, "Output file (.nrrd .nhdr .nii .nii.gz .mha .mhd)")->required();
+    cmd->add_option("--out,-o", a->out, "Output file (.nrrd .nhdr .nii .nii.gz .mha .mhd)")
+        ->required();
     cmd->callback([a] { run(*a); });
 }
 

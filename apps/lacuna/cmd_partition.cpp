@@ -189,8 +189,7 @@ void run(const PartitionArgs& a) {
         b.elevation = a.elevation;
         b.repeat = a.repeat;
         validate(b.options);  // before loading anything
-        if (b.repeat < 1 || b.repeat > 1000)
-            throw Error("--repeat", "repeat", "expected 1..1000");
+        if (b.repeat < 1 || b.repeat > 1000) throw Error("--repeat", "repeat", "expected 1..1000");
         resolve_transfer_function(b.tf);
         run_partition_boxes(b, load_volume(a.volume));
         return;

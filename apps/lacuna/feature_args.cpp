@@ -58,47 +58,77 @@ std::vector<GradientOpacityPoint> gradient_points(const std::string& s) {
 
 void add_feature_args(CLI::App& cmd, FeatureArgs& a) {
     const char* g = "Shading and clipping";
-    cmd.add_option("--shading", a.shading, "Shading model: none, phong, pbr")->capture_default_str()->group(g);
-    cmd.add_option("--phong", a.phong, "Blinn-Phong terms KA,KD,KS,POWER (default 0.25,0.7,0.35,24)")->group(g);
-    cmd.add_option("--pbr", a.pbr, "PBR ROUGHNESS,METALLIC[,AMBIENT] (default 0.45,0,0.2)")->group(g);
-    cmd.add_flag("--gradient-volume", a.gradient_volume,
-                 "Precompute a gradient volume (12 bytes per voxel) instead of on-the-fly gradients")
+    cmd.add_option("--shading", a.shading, "Shading model: none, phong, pbr")
+        ->capture_default_str()
         ->group(g);
-    cmd.add_option("--gradient-opacity", a.gradient_opacity,
-                   "Gradient-magnitude opacity (|grad| in values per mm): a ramp LO,HI (opacity x 0 "
-                   "below LO, x 1 above HI), points X:A,X:A,... (piecewise linear), or none")
+    cmd.add_option("--phong", a.phong,
+                   "Blinn-Phong terms KA,KD,KS,POWER (default 0.25,0.7,0.35,24)")
         ->group(g);
-    cmd.add_option("--light", a.light,
-                   "Light: head, dir:X,Y,Z (toward the light), spot:PX,PY,PZ,TX,TY,TZ[,CONE] (world mm, "
-                   "cone half-angle in degrees, default 30)")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--light-intensity", a.light_intensity, "Light intensity")->capture_default_str()->group(g);
-    cmd.add_flag("--shadows", a.shadows, "Shadow rays toward the light through the skipping structure")->group(g);
-    cmd.add_option("--shadow-step", a.shadow_step, "Shadow-ray sample distance (smallest voxel spacings)")
-        ->capture_default_str()->group(g);
+    cmd.add_option("--pbr", a.pbr, "PBR ROUGHNESS,METALLIC[,AMBIENT] (default 0.45,0,0.2)")
+        ->group(g);
+    cmd.add_flag(
+           "--gradient-volume", a.gradient_volume,
+           "Precompute a gradient volume (12 bytes per voxel) instead of on-the-fly gradients")
+        ->group(g);
+    cmd.add_option(
+           "--gradient-opacity", a.gradient_opacity,
+           "Gradient-magnitude opacity (|grad| in values per mm): a ramp LO,HI (opacity x 0 "
+           "below LO, x 1 above HI), points X:A,X:A,... (piecewise linear), or none")
+        ->group(g);
+    cmd.add_option(
+           "--light", a.light,
+           "Light: head, dir:X,Y,Z (toward the light), spot:PX,PY,PZ,TX,TY,TZ[,CONE] (world mm, "
+           "cone half-angle in degrees, default 30)")
+        ->capture_default_str()
+        ->group(g);
+    cmd.add_option("--light-intensity", a.light_intensity, "Light intensity")
+        ->capture_default_str()
+        ->group(g);
+    cmd.add_flag("--shadows", a.shadows,
+                 "Shadow rays toward the light through the skipping structure")
+        ->group(g);
+    cmd.add_option("--shadow-step", a.shadow_step,
+                   "Shadow-ray sample distance (smallest voxel spacings)")
+        ->capture_default_str()
+        ->group(g);
     cmd.add_flag("--unaccelerated-shadows", a.unaccelerated_shadows,
-                 "March every shadow-ray sample (the reference for --shadows)")->group(g);
-    cmd.add_flag("--light-volume", a.light_volume,
-                 "With --shadows: precompute the transmittance toward the light on a voxel grid")->group(g);
-    cmd.add_option("--light-volume-stride", a.light_volume_stride, "Light volume: every N-th voxel")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--clip", a.clip, "Clip plane NX,NY,NZ,D (world mm): keeps dot(n,p) >= D; repeatable")
-        ->take_all()->group(g);
-    cmd.add_option("--crop", a.crop, "Crop box X0,X1,Y0,Y1,Z0,Z1 (world mm)")->group(g);
-    cmd.add_option("--tf-back", a.tf_back,
-                   "TF on the back side of the first --clip plane (which then splits instead of clipping)")
+                 "March every shadow-ray sample (the reference for --shadows)")
         ->group(g);
-    cmd.add_option("--blend", a.blend, "Blend mode: composite, mip, minip, average")->capture_default_str()->group(g);
+    cmd.add_flag("--light-volume", a.light_volume,
+                 "With --shadows: precompute the transmittance toward the light on a voxel grid")
+        ->group(g);
+    cmd.add_option("--light-volume-stride", a.light_volume_stride, "Light volume: every N-th voxel")
+        ->capture_default_str()
+        ->group(g);
+    cmd.add_option("--clip", a.clip,
+                   "Clip plane NX,NY,NZ,D (world mm): keeps dot(n,p) >= D; repeatable")
+        ->take_all()
+        ->group(g);
+    cmd.add_option("--crop", a.crop, "Crop box X0,X1,Y0,Y1,Z0,Z1 (world mm)")->group(g);
+    cmd.add_option(
+           "--tf-back", a.tf_back,
+           "TF on the back side of the first --clip plane (which then splits instead of clipping)")
+        ->group(g);
+    cmd.add_option("--blend", a.blend, "Blend mode: composite, mip, minip, average")
+        ->capture_default_str()
+        ->group(g);
     cmd.add_flag("--jitter", a.jitter, "Jittered ray starts (deterministic per pixel)")->group(g);
-    cmd.add_option("--jitter-seed", a.jitter_seed, "Seed of --jitter")->capture_default_str()->group(g);
+    cmd.add_option("--jitter-seed", a.jitter_seed, "Seed of --jitter")
+        ->capture_default_str()
+        ->group(g);
 }
 
 FeatureOptions parse_features(const FeatureArgs& a) {
     FeatureOptions f;
-    if (a.shading == "none") f.shading = ShadingModel::None;
-    else if (a.shading == "phong") f.shading = ShadingModel::Phong;
-    else if (a.shading == "pbr") f.shading = ShadingModel::Pbr;
-    else throw Error("--shading", "model", "unknown '" + a.shading + "'; expected one of: none, phong, pbr");
+    if (a.shading == "none")
+        f.shading = ShadingModel::None;
+    else if (a.shading == "phong")
+        f.shading = ShadingModel::Phong;
+    else if (a.shading == "pbr")
+        f.shading = ShadingModel::Pbr;
+    else
+        throw Error("--shading", "model",
+                    "unknown '" + a.shading + "'; expected one of: none, phong, pbr");
     if (!a.phong.empty()) {
         const auto v = floats(a.phong, "--phong", "terms", 4);
         f.phong = {v[0], v[1], v[2], v[3]};
@@ -134,8 +164,9 @@ FeatureOptions parse_features(const FeatureArgs& a) {
         f.light.target = {v[3], v[4], v[5]};
         if (v.size() == 7) f.light.cone_deg = v[6];
     } else {
-        throw Error("--light", "light",
-                    "unknown '" + a.light + "'; expected head, dir:X,Y,Z or spot:PX,PY,PZ,TX,TY,TZ[,CONE]");
+        throw Error(
+            "--light", "light",
+            "unknown '" + a.light + "'; expected head, dir:X,Y,Z or spot:PX,PY,PZ,TX,TY,TZ[,CONE]");
     }
     f.light.intensity = a.light_intensity;
     f.shadows.enabled = a.shadows;
@@ -157,11 +188,17 @@ FeatureOptions parse_features(const FeatureArgs& a) {
     }
     if (!a.tf_back.empty() && a.clip.empty())
         throw Error("--tf-back", "clip plane", "expected a --clip plane to split the two TFs at");
-    if (a.blend == "composite") f.blend = BlendMode::Composite;
-    else if (a.blend == "mip") f.blend = BlendMode::Mip;
-    else if (a.blend == "minip") f.blend = BlendMode::MinIp;
-    else if (a.blend == "average") f.blend = BlendMode::Average;
-    else throw Error("--blend", "mode", "unknown '" + a.blend + "'; expected one of: composite, mip, minip, average");
+    if (a.blend == "composite")
+        f.blend = BlendMode::Composite;
+    else if (a.blend == "mip")
+        f.blend = BlendMode::Mip;
+    else if (a.blend == "minip")
+        f.blend = BlendMode::MinIp;
+    else if (a.blend == "average")
+        f.blend = BlendMode::Average;
+    else
+        throw Error("--blend", "mode",
+                    "unknown '" + a.blend + "'; expected one of: composite, mip, minip, average");
     f.jitter = a.jitter;
     f.jitter_seed = a.jitter_seed;
     validate_features(f);
@@ -173,9 +210,11 @@ std::string describe(const FeatureOptions& f) {
     auto add = [&](const std::string& x) { s += (s.empty() ? "" : ", ") + x; };
     if (f.shading != ShadingModel::None)
         add("shading " + to_string(f.shading) +
-            (f.gradient == GradientSource::Precomputed ? " (gradient volume)" : " (on-the-fly gradients)"));
+            (f.gradient == GradientSource::Precomputed ? " (gradient volume)"
+                                                       : " (on-the-fly gradients)"));
     if (f.gradient_opacity.enabled) add("gradient opacity");
-    if (f.shading != ShadingModel::None || f.shadows.enabled) add("light " + to_string(f.light.kind));
+    if (f.shading != ShadingModel::None || f.shadows.enabled)
+        add("light " + to_string(f.light.kind));
     if (f.shadows.enabled)
         add(std::string("shadows") + (f.shadows.light_volume ? " (light volume)" : "") +
             (f.shadows.accelerate ? "" : " (unaccelerated)"));

@@ -2,7 +2,6 @@
 // the command line become lacuna::FeatureOptions here (STYLE.md habit 3). docs/cli.md, "Shading".
 #pragma once
 #include <CLI/CLI.hpp>
-
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -14,10 +13,10 @@ namespace lacuna::cli {
 
 struct FeatureArgs {
     std::string shading = "none";
-    std::string phong, pbr;       // "KA,KD,KS,POWER" / "ROUGHNESS,METALLIC[,AMBIENT]"
+    std::string phong, pbr;  // "KA,KD,KS,POWER" / "ROUGHNESS,METALLIC[,AMBIENT]"
     bool gradient_volume = false;
-    std::string gradient_opacity; // "LO,HI", "X:A,X:A,..." or "none"
-    std::string light = "head";   // head | dir:X,Y,Z | spot:PX,PY,PZ,TX,TY,TZ[,CONE]
+    std::string gradient_opacity;  // "LO,HI", "X:A,X:A,..." or "none"
+    std::string light = "head";    // head | dir:X,Y,Z | spot:PX,PY,PZ,TX,TY,TZ[,CONE]
     float light_intensity = 1.f;
     bool shadows = false, light_volume = false, unaccelerated_shadows = false;
     float shadow_step = 1.f;

@@ -39,7 +39,8 @@ void check_subcommand(const CLI::App& app, int argc, char** argv) {
     for (const CLI::App* s : app.get_subcommands([](const CLI::App*) { return true; })) {
         if (s->get_name() == word) return;
         names += (names.empty() ? "" : ", ") + s->get_name();
-        if (const size_t d = distance(word, s->get_name()); d < best_d) best_d = d, best = s->get_name();
+        if (const size_t d = distance(word, s->get_name()); d < best_d)
+            best_d = d, best = s->get_name();
     }
     throw lacuna::Error("unknown command '" + word + "'" +
                         (best.empty() ? "" : " (did you mean '" + best + "'?)") +
@@ -49,8 +50,9 @@ void check_subcommand(const CLI::App& app, int argc, char** argv) {
 // --quiet on the app and on every subcommand, so both `lacuna --quiet render ...` and
 // `lacuna render ... --quiet` work (cli_common.h: progress and summaries, never errors).
 void add_quiet(CLI::App& app) {
-    app.add_flag_callback("--quiet,-q", [] { lacuna::cli::set_quiet(true); },
-                          "No progress lines or summaries on stderr (errors are still printed)");
+    app.add_flag_callback(
+        "--quiet,-q", [] { lacuna::cli::set_quiet(true); },
+        "No progress lines or summaries on stderr (errors are still printed)");
     for (CLI::App* s : app.get_subcommands([](const CLI::App*) { return true; })) add_quiet(*s);
 }
 

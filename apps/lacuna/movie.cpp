@@ -55,7 +55,8 @@ MovieWriter::MovieWriter(std::string path, int width, int height, int fps)
     std::string log = (fs::temp_directory_path() / "lacuna-ffmpeg-XXXXXX").string();
     const int log_fd = ::mkstemp(log.data());
     if (log_fd < 0)
-        throw Error(m_path, "movie", std::string("cannot create ffmpeg's log: ") + std::strerror(errno));
+        throw Error(m_path, "movie",
+                    std::string("cannot create ffmpeg's log: ") + std::strerror(errno));
     m_log = log;
     int pipe_fd[2];
     if (::pipe2(pipe_fd, O_CLOEXEC) != 0) {
@@ -69,8 +70,8 @@ MovieWriter::MovieWriter(std::string path, int width, int height, int fps)
     const std::vector<std::string> args = {
         ffmpeg, "-nostdin", "-hide_banner", "-loglevel", "error", "-y",
         // the input: raw RGBA frames on stdin, top row first (lacuna::Image)
-        "-f", "rawvideo", "-pix_fmt", "rgba", "-s", size, "-framerate", std::to_string(fps),
-        "-i", "pipe:0",
+        "-f", "rawvideo", "-pix_fmt", "rgba", "-s", size, "-framerate", std::to_string(fps), "-i",
+        "pipe:0",
         // H.264 needs even edges in yuv420p: pad an odd one with a black row or column
         "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p",
         "-movflags", "+faststart", "-f", "mp4", m_tmp};

@@ -29,7 +29,7 @@ std::string find_ffmpeg();
 void require_ffmpeg();
 
 class MovieWriter {
-public:
+  public:
     // Starts ffmpeg encoding width x height RGBA frames at `fps` into a temporary beside `path`.
     MovieWriter(std::string path, int width, int height, int fps);
     // Sends one frame (its size must be the movie's). Throws lacuna::Error if ffmpeg has gone.
@@ -42,7 +42,7 @@ public:
     MovieWriter& operator=(const MovieWriter&) = delete;
     int frames() const { return m_frames; }
 
-private:
+  private:
     [[noreturn]] void fail(const std::string& what);
     int wait_status();
     std::string m_path, m_tmp, m_tmp_dir, m_log;

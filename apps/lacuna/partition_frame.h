@@ -4,13 +4,13 @@
 //
 // Why: the kd-tree splits a node's longest axis (ties: the lower index axis) at candidate planes
 // counted from the node's low index end, keeping the first of equal costs, and the growing boxes
-// grow from the first free block in x-fastest order; both depend on the voxel order, so one anatomy stored RAS, LPS or in a sagittal order would give
-// three different sets of boxes. Built on the reordered voxels, every storage whose axes differ
-// from another's by a permutation and flips (a signed permutation of the index axes, which moves
-// no voxel off the lattice) gives the same voxels in the same order, hence the same boxes, bit
-// for bit, at the same world positions. What is rendered is still rendered from the file's own
-// voxels and structures (exact against --accel none); only the boxes drawn and listed come from
-// the reordered copy.
+// grow from the first free block in x-fastest order; both depend on the voxel order, so one anatomy
+// stored RAS, LPS or in a sagittal order would give three different sets of boxes. Built on the
+// reordered voxels, every storage whose axes differ from another's by a permutation and flips (a
+// signed permutation of the index axes, which moves no voxel off the lattice) gives the same voxels
+// in the same order, hence the same boxes, bit for bit, at the same world positions. What is
+// rendered is still rendered from the file's own voxels and structures (exact against --accel
+// none); only the boxes drawn and listed come from the reordered copy.
 //
 // Which file axis becomes which: the free index axis most along superior first, then the one
 // most along right, then the last, each reversed when it points the other way (inferior, left,
@@ -18,9 +18,8 @@
 // to the lower file axis, so two storages of such a file may still differ.
 #pragma once
 #include <array>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "accel/region.h"
 #include "lacuna/math.h"

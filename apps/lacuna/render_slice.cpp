@@ -4,8 +4,8 @@
 
 #include "core/parallel.h"
 #include "lacuna/error.h"
-#include "lacuna/transfer_function.h"
 #include "lacuna/session.h"
+#include "lacuna/transfer_function.h"
 
 namespace lacuna::cli {
 
@@ -24,8 +24,9 @@ void add_slice_options(CLI::App& cmd, SliceCliArgs& a) {
                    "Slicer, --accel boxes: render a BSP subtree as one box when at most this "
                    "share of it is empty (exact for any value; negative: every leaf alone)")
         ->capture_default_str();
-    cmd.add_option("--coalesce-edge", a.coalesce_edge,
-                   "Slicer, --accel boxes: largest box --coalesce makes, per axis in world units (mm)")
+    cmd.add_option(
+           "--coalesce-edge", a.coalesce_edge,
+           "Slicer, --accel boxes: largest box --coalesce makes, per axis in world units (mm)")
         ->capture_default_str();
 }
 
@@ -61,23 +62,26 @@ void render_slice(const SliceRenderJob& job) {
     write_png(job.out, r.image);
     const SlicerFrameStats& s = *r.slicer;
     const FrameSpec& f = job.spec;
-    std::printf("%s: %dx%d %s, tf %s, slice renderer, accel %s, %d threads\n",
-                job.volume.path.c_str(), f.width, f.height,
-                f.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
-                tf.name.c_str(), job.accel.c_str(), resolve_threads(job.threads));
-    std::printf("render time %.1f ms (polygon set-up %.1f%% of CPU time, %.1f%% of wall time), "
-                "%llu boxes, %llu polygons, %.1f Msamples/s\n",
-                r.stats.seconds * 1e3, 100 * s.setup_cpu_fraction, 100 * s.setup_fraction,
-                (unsigned long long)s.boxes, (unsigned long long)s.polygons,
-                r.stats.seconds > 0 ? double(r.stats.samples) / r.stats.seconds * 1e-6 : 0);
+    std::printf(
+        "%s: %dx%d %s, tf %s, slice renderer, accel %s, %d threads\n", job.volume.path.c_str(),
+        f.width, f.height,
+        f.camera.orbit.projection == Projection::Orthographic ? "orthographic" : "perspective",
+        tf.name.c_str(), job.accel.c_str(), resolve_threads(job.threads));
+    std::printf(
+        "render time %.1f ms (polygon set-up %.1f%% of CPU time, %.1f%% of wall time), "
+        "%llu boxes, %llu polygons, %.1f Msamples/s\n",
+        r.stats.seconds * 1e3, 100 * s.setup_cpu_fraction, 100 * s.setup_fraction,
+        (unsigned long long)s.boxes, (unsigned long long)s.polygons,
+        r.stats.seconds > 0 ? double(r.stats.samples) / r.stats.seconds * 1e-6 : 0);
     if (f.slicer.occlusion)
-        std::printf("occlusion (threshold %.3g, map %dx%d): %d/%d map updates, %llu boxes culled, "
-                    "%llu clipped, %.1f%% of non-empty voxels skipped (%.1f%% culled, %.1f%% "
-                    "clipped), %.1f ms\n",
-                    f.slicer.occlusion_threshold, f.slicer.occlusion_map, f.slicer.occlusion_map,
-                    s.map_updates, s.desired_updates, (unsigned long long)s.boxes_culled,
-                    (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction,
-                    100 * s.culled_fraction, 100 * s.clipped_fraction, s.occlusion_seconds * 1e3);
+        std::printf(
+            "occlusion (threshold %.3g, map %dx%d): %d/%d map updates, %llu boxes culled, "
+            "%llu clipped, %.1f%% of non-empty voxels skipped (%.1f%% culled, %.1f%% "
+            "clipped), %.1f ms\n",
+            f.slicer.occlusion_threshold, f.slicer.occlusion_map, f.slicer.occlusion_map,
+            s.map_updates, s.desired_updates, (unsigned long long)s.boxes_culled,
+            (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction, 100 * s.culled_fraction,
+            100 * s.clipped_fraction, s.occlusion_seconds * 1e3);
     std::printf("wrote %s\n", job.out.c_str());
 }
 

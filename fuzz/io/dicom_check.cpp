@@ -8,12 +8,13 @@
 //   - "checked" means the elements tile the file to its last byte, so the same bytes with the
 //     last one cut off must be an error (every decision before the last element reads the same
 //     bytes; the last element then runs one byte past the end, or its header is cut).
+#include "io/dicom_check.h"
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 
-#include "io/dicom_check.h"
 #include "lacuna/error.h"
 
 namespace {
@@ -51,8 +52,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (w.checked && size > 140) {
         lacuna::io::DicomWalk cut;
         if (walk(data, size - 1, cut)) {
-            std::fprintf(stderr, "fuzz: a checked file of %zu bytes passes cut by one (checked %d)\n",
-                         size, int(cut.checked));
+            std::fprintf(stderr,
+                         "fuzz: a checked file of %zu bytes passes cut by one (checked %d)\n", size,
+                         int(cut.checked));
             std::abort();
         }
     }

@@ -25,7 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (rest.size() >= 4) {
         uint8_t w[4];
         std::memcpy(w, rest.data(), 4);
-        if ((w[0] == 0x1c && w[1] == 0x02 && !w[2] && !w[3]) || (!w[0] && !w[1] && w[2] == 0x02 && w[3] == 0x1c))
+        if ((w[0] == 0x1c && w[1] == 0x02 && !w[2] && !w[3]) ||
+            (!w[0] && !w[1] && w[2] == 0x02 && w[3] == 0x1c))
             split = 540;
     }
     split = std::min(split, rest.size());

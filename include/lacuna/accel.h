@@ -20,16 +20,16 @@
 namespace lacuna {
 
 enum class AccelKind {
-    None,       // march every lattice sample of the ray's box interval (the reference)
-    MinMax,     // min-max octree; empty when the TF's opacity prefix sum is 0 over [min, max]
-    Bitfield,   // the bitfield paper's TF-independent octree (bins of the visualization range)
-    Boolean,    // TF-dependent occupancy octree, rebuilt when the TF changes
-    Distance,   // Euclidean distance map at 1/4 resolution, rebuilt when the TF changes
-    Chebyshev,  // Chebyshev distance map at 1/4 resolution, rebuilt when the TF changes
-    KdTree,     // kd-tree empty-space partition (kd-tree paper), rebuilt when the TF changes
+    None,            // march every lattice sample of the ray's box interval (the reference)
+    MinMax,          // min-max octree; empty when the TF's opacity prefix sum is 0 over [min, max]
+    Bitfield,        // the bitfield paper's TF-independent octree (bins of the visualization range)
+    Boolean,         // TF-dependent occupancy octree, rebuilt when the TF changes
+    Distance,        // Euclidean distance map at 1/4 resolution, rebuilt when the TF changes
+    Chebyshev,       // Chebyshev distance map at 1/4 resolution, rebuilt when the TF changes
+    KdTree,          // kd-tree empty-space partition (kd-tree paper), rebuilt when the TF changes
     MinMaxInterval,  // the min-max octree as the bitfield paper tests it: empty when [min, max]
                      // misses the TF's one interval [first visible entry, last visible entry]
-    Grid,       // per-TF occupancy grid of bricks (apron-inclusive ranges), two-level 3D DDA
+    Grid,            // per-TF occupancy grid of bricks (apron-inclusive ranges), two-level 3D DDA
 };
 
 std::string to_string(AccelKind k);
@@ -63,17 +63,17 @@ struct AccelOptions {
     // The sampling the structure must be exact for (see Interpolation); only the bitfield octree
     // builds differently for Nearest, every other structure is exact for both as built.
     Interpolation interpolation = Interpolation::Trilinear;
-    int leaf_cells = 8;        // octree leaf edge in cells (2..64, power of two)
-    int bitfield_bits = 64;    // bitfield width: 8, 16, 32, 64 or 128
-    int initial_level = -1;    // octree level traversal starts at (-1 = the root)
-    bool bidirectional = true; // octree traversal moves up and down (false: top-down only)
-    int distance_block = 4;    // distance maps: cells per map voxel (the paper's 1/4 resolution)
-    int threads = 0;           // build threads (0 = all)
-    int kd_max_boxes = 0;         // kd-tree: M, most subvolumes in the list (0 = every leaf)
-    int kd_delta = 0;             // kd-tree: candidate plane spacing in cells (0 = from size)
-    float kd_min_volume = 0.1f;   // kd-tree: nodes below this fraction of the grid are leaves
-    float kd_min_gain = 0.05f;    // kd-tree: a split must remove this fraction of its node
-    int kd_max_depth = 10;        // kd-tree: deepest split level (root = 0)
+    int leaf_cells = 8;          // octree leaf edge in cells (2..64, power of two)
+    int bitfield_bits = 64;      // bitfield width: 8, 16, 32, 64 or 128
+    int initial_level = -1;      // octree level traversal starts at (-1 = the root)
+    bool bidirectional = true;   // octree traversal moves up and down (false: top-down only)
+    int distance_block = 4;      // distance maps: cells per map voxel (the paper's 1/4 resolution)
+    int threads = 0;             // build threads (0 = all)
+    int kd_max_boxes = 0;        // kd-tree: M, most subvolumes in the list (0 = every leaf)
+    int kd_delta = 0;            // kd-tree: candidate plane spacing in cells (0 = from size)
+    float kd_min_volume = 0.1f;  // kd-tree: nodes below this fraction of the grid are leaves
+    float kd_min_gain = 0.05f;   // kd-tree: a split must remove this fraction of its node
+    int kd_max_depth = 10;       // kd-tree: deepest split level (root = 0)
     std::optional<float> kd_threshold;  // kd-tree: value threshold (`lacuna partition` only)
 };
 
@@ -88,7 +88,7 @@ struct AccelStats {
 // A built structure over one volume. Concrete types live in src/accel/; renderers reach them
 // through visit() in src/accel/accel_impl.h, once per frame, never per sample.
 class Accel {
-public:
+  public:
     virtual ~Accel() = default;
     AccelKind kind() const { return m_kind; }
     // Must be called before rendering and whenever the TF changes; frames are correct (and
@@ -104,7 +104,7 @@ public:
     // The sampling this structure is exact for: Trilinear (then also Nearest) or Nearest only.
     Interpolation interpolation() const { return m_interpolation; }
 
-protected:
+  protected:
     explicit Accel(AccelKind k) : m_kind(k) {}
     AccelKind m_kind;
     AccelStats m_stats;

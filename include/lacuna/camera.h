@@ -35,7 +35,7 @@ struct OrbitParams {
 };
 
 class Camera {
-public:
+  public:
     Camera() = default;
     // A camera that sees all of `bounds` (world box) for the given image size.
     static Camera orbit(const Box3f& bounds, const OrbitParams& p, int width, int height);
@@ -57,7 +57,7 @@ public:
     float half_height() const { return m_half_h; }
     Projection projection() const { return m_projection; }
 
-private:
+  private:
     Vec3f m_eye{}, m_forward{0, 0, -1}, m_right{1, 0, 0}, m_up{0, 1, 0};
     float m_half_h = 1.f;  // tan(fov/2) for perspective; half the view height for orthographic
     int m_width = 1, m_height = 1;

@@ -9,7 +9,7 @@
 namespace lacuna {
 
 class Error : public std::runtime_error {
-public:
+  public:
     explicit Error(const std::string& what) : std::runtime_error(what) {}
     // where: a file name or option ("ch2.nii.gz", "--tf"); field: the part that is wrong
     // ("dims", "opacity[3].x"); what: what was expected and what was found.
@@ -23,13 +23,15 @@ public:
 // structures and validate() throw it; a front end translates the field into its own vocabulary
 // (the CLI into its flags, apps/lacuna/frame_flags.cpp; Python into its keywords).
 class FrameError : public Error {
-public:
+  public:
     FrameError(std::string field, std::string expected)
-        : Error("frame", field, expected), m_field(std::move(field)), m_expected(std::move(expected)) {}
+        : Error("frame", field, expected),
+          m_field(std::move(field)),
+          m_expected(std::move(expected)) {}
     const std::string& field() const { return m_field; }
     const std::string& expected() const { return m_expected; }
 
-private:
+  private:
     std::string m_field, m_expected;
 };
 

@@ -77,7 +77,7 @@ struct Boolean {
     Octree octree;
     friend bool operator==(const Boolean&, const Boolean&) = default;
 };
-struct Distance {  // Euclidean
+struct Distance {   // Euclidean
     int block = 4;  // cells per map voxel
     friend bool operator==(const Distance&, const Distance&) = default;
 };
@@ -86,11 +86,11 @@ struct Chebyshev {
     friend bool operator==(const Chebyshev&, const Chebyshev&) = default;
 };
 struct KdTree {
-    int max_boxes = 0;         // M, most subvolumes in the list (0 = every leaf)
-    int delta = 0;             // candidate plane spacing in cells (0 = from size)
-    float min_volume = 0.1f;   // nodes below this fraction of the grid are leaves
-    float min_gain = 0.05f;    // a split must remove this fraction of its node
-    int max_depth = 10;        // deepest split level (root = 0)
+    int max_boxes = 0;        // M, most subvolumes in the list (0 = every leaf)
+    int delta = 0;            // candidate plane spacing in cells (0 = from size)
+    float min_volume = 0.1f;  // nodes below this fraction of the grid are leaves
+    float min_gain = 0.05f;   // a split must remove this fraction of its node
+    int max_depth = 10;       // deepest split level (root = 0)
     friend bool operator==(const KdTree&, const KdTree&) = default;
 };
 struct Grid {  // the brick grid (the default: default_accel())
@@ -98,8 +98,8 @@ struct Grid {  // the brick grid (the default: default_accel())
 };
 // Growing boxes ordered by their BSP tree (the slicer only; docs/growing-boxes.md).
 struct GrowingBoxes {
-    float coalesce = 0.25f;       // BoxesOptions::coalesce
-    float coalesce_edge = 64.f;   // BoxesOptions::coalesce_edge (mm)
+    float coalesce = 0.25f;      // BoxesOptions::coalesce
+    float coalesce_edge = 64.f;  // BoxesOptions::coalesce_edge (mm)
     friend bool operator==(const GrowingBoxes&, const GrowingBoxes&) = default;
 };
 // The label bitfield octree (the segment renderer only): labels and intensity bins per node.
@@ -113,11 +113,10 @@ struct LabelOctree {
 
 // In the order of src/session/structure_registry.h (one entry per alternative): the order
 // accel_names(), the benchmarks' columns and the capabilities table's rows list them in.
-using Structure =
-    std::variant<structure::None, structure::Distance, structure::Chebyshev,
-                 structure::Boolean, structure::MinMax, structure::Bitfield,
-                 structure::KdTree, structure::MinMaxInterval, structure::Grid,
-                 structure::GrowingBoxes, structure::LabelOctree>;
+using Structure = std::variant<structure::None, structure::Distance, structure::Chebyshev,
+                               structure::Boolean, structure::MinMax, structure::Bitfield,
+                               structure::KdTree, structure::MinMaxInterval, structure::Grid,
+                               structure::GrowingBoxes, structure::LabelOctree>;
 
 // The structure's name: an accel_names() entry, "boxes" or "label-octree".
 std::string structure_name(const Structure& s);
@@ -158,11 +157,11 @@ enum class OcclusionUse {
 };
 
 struct SlicerSpec {
-    bool occlusion = false;          // occlusion culling and clipping against the opacity map
+    bool occlusion = false;             // occlusion culling and clipping against the opacity map
     float occlusion_threshold = 0.95f;  // (0, 1]; 1 is exact
-    int occlusion_map = 64;          // map edge in cells, 1..4096
+    int occlusion_map = 64;             // map edge in cells, 1..4096
     OcclusionUse occlusion_use = OcclusionUse::CullClip;
-    int occlusion_updates = 9;       // map updates per frame (k), >= 0
+    int occlusion_updates = 9;  // map updates per frame (k), >= 0
     // Section 4.4's controller picks the updates per frame instead, from occlusion_updates on,
     // learning from the frame before. It learns over the session's consecutive frames with this
     // structure and slicer spec; any other frame in between starts it afresh.
@@ -206,18 +205,18 @@ struct FrameSpec {
 // ---- Capabilities -------------------------------------------------------------------------------
 // What a renderer can do beyond the common part (step, camera, image, background).
 enum class Feature {
-    Shading,          // features.shading, lights
-    GradientOpacity,  // features.gradient_opacity
-    Shadows,          // features.shadows
-    ClipPlanes,       // features.clip_planes
-    Crop,             // features.crop
-    Blend,            // features.blend other than Composite
-    Jitter,           // features.jitter
-    TwoTfs,           // two_tfs
-    Nearest,          // sampling.interpolation Nearest
-    EarlyTermination, // sampling.early_termination set
-    SampleCounts,     // count_samples
-    Occlusion,        // slicer.occlusion
+    Shading,           // features.shading, lights
+    GradientOpacity,   // features.gradient_opacity
+    Shadows,           // features.shadows
+    ClipPlanes,        // features.clip_planes
+    Crop,              // features.crop
+    Blend,             // features.blend other than Composite
+    Jitter,            // features.jitter
+    TwoTfs,            // two_tfs
+    Nearest,           // sampling.interpolation Nearest
+    EarlyTermination,  // sampling.early_termination set
+    SampleCounts,      // count_samples
+    Occlusion,         // slicer.occlusion
 };
 std::string to_string(Feature f);
 std::vector<Feature> all_features();
@@ -241,7 +240,7 @@ const RendererCapabilities& capabilities(Renderer r);
 // Slicer's shading terms and gradient opacity, a MIP preset's blend). It is a default, not an
 // order: each part applies only where the user did not set the feature and the renderer takes it
 // (capabilities(); the slicer and the segment renderer take none of them).
-struct TfRenderingOverrides {  // true: the user set it, the TF's rendering leaves it alone
+struct TfRenderingOverrides {       // true: the user set it, the TF's rendering leaves it alone
     bool shading = false;           // the model (features.shading; the CLI's --shading)
     bool phong = false;             // the Phong terms (features.phong; --phong)
     bool gradient_opacity = false;  // features.gradient_opacity (--gradient-opacity)

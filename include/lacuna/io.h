@@ -47,10 +47,11 @@ struct ReadOptions {
 };
 
 // Reads a volume: .nii/.nii.gz (NIfTI-1/2; of a 4D file the volume ReadOptions::frame),
-// .nrrd/.nhdr, .mha/.mhd, a folder of DICOM slices, or .raw. Voxel types other than uint8/int16/uint16/float32 are converted (int8 -> int16,
-// uint32/int32/float64 -> float32); non-scalar images are rejected. Computes the value range
-// and rejects NaN/Inf. The voxels are read once into the Volume's own buffer (no second
-// full-size copy). Throws lacuna::Error("<path>", "<field>", "<problem>") on any bad input.
+// .nrrd/.nhdr, .mha/.mhd, a folder of DICOM slices, or .raw. Voxel types other than
+// uint8/int16/uint16/float32 are converted (int8 -> int16, uint32/int32/float64 -> float32);
+// non-scalar images are rejected. Computes the value range and rejects NaN/Inf. The voxels are read
+// once into the Volume's own buffer (no second full-size copy). Throws lacuna::Error("<path>",
+// "<field>", "<problem>") on any bad input.
 Volume read_volume(const std::string& path, const ReadOptions& opts = {});
 
 // Parses "name_301x370x316_uint8.raw"-style names; nullopt if the name does not match.

@@ -21,7 +21,9 @@ struct Vec3 {
     friend constexpr Vec3 operator*(T s, Vec3 a) { return {a.x * s, a.y * s, a.z * s}; }
     friend constexpr Vec3 operator/(Vec3 a, T s) { return {a.x / s, a.y / s, a.z / s}; }
     friend constexpr Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
-    friend constexpr bool operator==(Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+    friend constexpr bool operator==(Vec3 a, Vec3 b) {
+        return a.x == b.x && a.y == b.y && a.z == b.z;
+    }
     template <class U>
     constexpr explicit operator Vec3<U>() const {
         return {static_cast<U>(x), static_cast<U>(y), static_cast<U>(z)};
@@ -32,15 +34,21 @@ using Vec3d = Vec3<double>;
 using Vec3i = Vec3<int>;
 
 template <class T>
-constexpr T dot(Vec3<T> a, Vec3<T> b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr T dot(Vec3<T> a, Vec3<T> b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 template <class T>
 constexpr Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 template <class T>
-inline T length(Vec3<T> a) { return std::sqrt(dot(a, a)); }
+inline T length(Vec3<T> a) {
+    return std::sqrt(dot(a, a));
+}
 template <class T>
-inline Vec3<T> normalize(Vec3<T> a) { return a / length(a); }
+inline Vec3<T> normalize(Vec3<T> a) {
+    return a / length(a);
+}
 template <class T>
 constexpr Vec3<T> vmin(Vec3<T> a, Vec3<T> b) {
     return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
@@ -51,7 +59,8 @@ constexpr Vec3<T> vmax(Vec3<T> a, Vec3<T> b) {
 }
 template <class T>
 inline std::string to_string(Vec3<T> v) {
-    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
+    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +
+           ")";
 }
 
 // An axis-aligned box [lo, hi] (inclusive bounds, lo <= hi on every axis when non-empty).

@@ -61,7 +61,7 @@ struct SliceOptions {
     double pixel_mm = 0;  // 0: the smallest voxel spacing
     int max_size = 0;     // 0: no cap; else width and height <= max_size (coarser pixels)
     Interpolation interpolation = Interpolation::Trilinear;
-    int threads = 0;      // 0: all
+    int threads = 0;  // 0: all
 };
 
 // Where a slice's pixels are in the world: pixel (c, r) = origin + c * u + r * v (RAS mm).
@@ -104,13 +104,14 @@ void overlay_labels(Image& img, const std::vector<int32_t>& labels, const LabelT
 
 // What a click shows: the value at a world point and where it is in the grid.
 struct ProbeResult {
-    Vec3d world;           // the point asked, RAS mm
-    Vec3d index;           // continuous index A^-1 (world - t)
-    bool inside = false;   // index within the sampled box (kInsideTolerance)
+    Vec3d world;              // the point asked, RAS mm
+    Vec3d index;              // continuous index A^-1 (world - t)
+    bool inside = false;      // index within the sampled box (kInsideTolerance)
     Vec3i voxel{-1, -1, -1};  // nearest voxel (floor(index + 0.5)), when inside
-    float value = 0;       // trilinear (or nearest) sample, when inside; NaN outside
-    float voxel_value = 0; // the nearest voxel's own value, when inside
-    std::optional<int> label;  // the label map's nearest voxel at the point, when given and inside it
+    float value = 0;          // trilinear (or nearest) sample, when inside; NaN outside
+    float voxel_value = 0;    // the nearest voxel's own value, when inside
+    std::optional<int>
+        label;  // the label map's nearest voxel at the point, when given and inside it
     std::string label_name;
 };
 ProbeResult probe(const Volume& v, Vec3d world, Interpolation interp = Interpolation::Trilinear,

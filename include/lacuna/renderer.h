@@ -79,7 +79,7 @@ struct Light {
     LightKind kind = LightKind::Head;
     Vec3f direction{0, 0, 1};
     Vec3f position{0, 0, 0}, target{0, 0, 0};
-    float cone_deg = 30.f;   // spot: full intensity inside 0.8*cone, smooth falloff to 0 at cone
+    float cone_deg = 30.f;  // spot: full intensity inside 0.8*cone, smooth falloff to 0 at cone
     float intensity = 1.f;
 };
 
@@ -138,9 +138,9 @@ void validate_features(const FeatureOptions& f);
 inline constexpr float kNoEarlyTermination = 2.f;
 
 // One rank's share of a distributed frame (src/dist/, docs/distributed.md). The marcher's volume
-// is then a brick of a larger grid: its voxel (i, j, k) is the whole grid's voxel offset + (i, j, k),
-// and it keeps the whole grid's geometry (origin, direction, spacing), so rays, t_near, t_far and
-// the lattice t_k are those of the whole grid to the bit. The marcher takes exactly the whole
+// is then a brick of a larger grid: its voxel (i, j, k) is the whole grid's voxel offset + (i, j,
+// k), and it keeps the whole grid's geometry (origin, direction, spacing), so rays, t_near, t_far
+// and the lattice t_k are those of the whole grid to the bit. The marcher takes exactly the whole
 // grid's lattice samples whose position p (whole index space, the kernel's own float expression
 // p = o + t_k * d, before the clamp) has lo[a] <= p[a] < hi[a] on every axis; the bricks' owned
 // boxes partition space (the outer faces are -inf / +inf), so every sample of the single-process
@@ -148,19 +148,19 @@ inline constexpr float kNoEarlyTermination = 2.f;
 // (the cells an owned sample interpolates in). Early ray termination is off on this path (a rank
 // cannot know the opacity in front of its brick), and no features are taken yet.
 struct BrickOwnership {
-    Vec3i whole_dims{0, 0, 0};  // the whole grid's voxels per axis
-    Vec3i offset{0, 0, 0};      // whole-grid index of the brick's voxel (0, 0, 0)
+    Vec3i whole_dims{0, 0, 0};                   // the whole grid's voxels per axis
+    Vec3i offset{0, 0, 0};                       // whole-grid index of the brick's voxel (0, 0, 0)
     float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the owned box, whole index space, half open
 };
 std::string to_string(const BrickOwnership& b);
 
 struct RenderOptions {
-    float step = 0.5f;        // sample distance in units of the smallest voxel spacing
+    float step = 0.5f;  // sample distance in units of the smallest voxel spacing
     // Trilinear (default) or nearest-neighbour samples (lacuna/accel.h). A structure built for
     // Nearest is rejected with Trilinear (its sets with holes would not be exact).
     Interpolation interpolation = Interpolation::Trilinear;
-    float ert = 0.99f;        // early ray termination opacity; >= 1 turns it off (kNoEarlyTermination)
-    int threads = 0;          // 0 = all hardware threads
+    float ert = 0.99f;  // early ray termination opacity; >= 1 turns it off (kNoEarlyTermination)
+    int threads = 0;    // 0 = all hardware threads
     Vec3f background{0, 0, 0};
     bool count_samples = false;  // fill RenderResult::sample_counts (for --heatmap)
     bool keep_float = false;     // fill RenderResult::rgba_float (tests, error bounds)
@@ -174,15 +174,17 @@ struct RenderOptions {
 struct RenderStats {
     double seconds = 0;
     double cpu_seconds = 0;  // CPU time of the whole process (all threads) during the frame
-    uint64_t samples = 0;   // samples taken
-    uint64_t rays = 0;      // rays that hit the volume's box
+    uint64_t samples = 0;    // samples taken
+    uint64_t rays = 0;       // rays that hit the volume's box
     uint64_t pixels = 0;
-    uint64_t shadow_samples = 0;        // samples of shadow rays and light-volume rays
-    size_t gradient_volume_bytes = 0;   // memory of the precomputed gradient volume (0: none)
-    double gradient_volume_seconds = 0; // its computation in this render (0: cached or none)
-    size_t light_volume_bytes = 0;      // memory of the light volume (0: none)
-    double light_volume_seconds = 0;    // its computation in this render (0: cached or none)
-    double msamples_per_second() const { return seconds > 0 ? double(samples) / seconds * 1e-6 : 0; }
+    uint64_t shadow_samples = 0;         // samples of shadow rays and light-volume rays
+    size_t gradient_volume_bytes = 0;    // memory of the precomputed gradient volume (0: none)
+    double gradient_volume_seconds = 0;  // its computation in this render (0: cached or none)
+    size_t light_volume_bytes = 0;       // memory of the light volume (0: none)
+    double light_volume_seconds = 0;     // its computation in this render (0: cached or none)
+    double msamples_per_second() const {
+        return seconds > 0 ? double(samples) / seconds * 1e-6 : 0;
+    }
     double samples_per_ray() const { return rays ? double(samples) / double(rays) : 0; }
 };
 std::string to_string(const RenderStats& s);
@@ -190,13 +192,13 @@ std::string to_string(const RenderStats& s);
 struct RenderResult {
     Image image;
     std::vector<uint32_t> sample_counts;  // per pixel, when RenderOptions::count_samples
-    std::vector<float> rgba_float;  // per pixel premultiplied RGBA before the background and
-                                    // 8-bit rounding, when RenderOptions::keep_float
+    std::vector<float> rgba_float;        // per pixel premultiplied RGBA before the background and
+                                          // 8-bit rounding, when RenderOptions::keep_float
     RenderStats stats;
 };
 
 class RayMarcher {
-public:
+  public:
     // The volume must outlive the marcher. Its vis_range defines the TF domain.
     explicit RayMarcher(const Volume& volume);
     ~RayMarcher();
@@ -212,7 +214,7 @@ public:
     // World box of the volume: [0, (dims-1)*spacing].
     Box3f bounds() const;
 
-private:
+  private:
     RenderResult render_features(const Camera& camera, const RenderOptions& options) const;
     struct Cache;  // precomputed gradient and light volumes (src/render/ray_marcher.cpp)
     const Volume& m_volume;

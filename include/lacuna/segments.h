@@ -66,24 +66,24 @@ SegmentMode parse_segment_mode(const std::string& s, const std::string& where = 
 
 struct SegmentOptions {
     SegmentMode mode = SegmentMode::Masked;
-    bool skip = true;      // use the label bitfield octree (false: march every sample)
-    int leaf_cells = 8;    // octree leaf edge in cells (power of two, 2..64)
+    bool skip = true;        // use the label bitfield octree (false: march every sample)
+    int leaf_cells = 8;      // octree leaf edge in cells (power of two, 2..64)
     int bitfield_bits = 64;  // masked mode: the intensity bitfield's width
-    float tint = 0.f;      // masked mode: weight of the label colour against the TF colour
+    float tint = 0.f;        // masked mode: weight of the label colour against the TF colour
 };
 
 struct SegmentStats {
-    double build_seconds = 0;        // label octree (+ intensity bitfield) build
+    double build_seconds = 0;         // label octree (+ intensity bitfield) build
     double label_update_seconds = 0;  // last set_labels: the visibility change
-    size_t bytes = 0;                // octree memory
-    int label_words = 0;             // 64-bit words per node (labels rounded up to 64)
+    size_t bytes = 0;                 // octree memory
+    int label_words = 0;              // 64-bit words per node (labels rounded up to 64)
 };
 
 // Renders an intensity volume masked by labels, or a label volume alone, on the ray marcher's
 // sample lattice (include/lacuna/renderer.h). RenderOptions' step, ert, threads, background,
 // count_samples and keep_float apply. Volumes must outlive the renderer.
 class SegmentRenderer {
-public:
+  public:
     // intensity may be null in Labels mode. Builds the octree when options.skip.
     SegmentRenderer(const Volume* intensity, const Volume& labels, const SegmentOptions& options);
     ~SegmentRenderer();
@@ -101,7 +101,7 @@ public:
     Box3f bounds() const;
     const SegmentStats& stats() const { return m_stats; }
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;
     SegmentStats m_stats;

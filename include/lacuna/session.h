@@ -53,7 +53,7 @@ struct FrameResult {
     // Per pixel premultiplied RGBA before the background and the 8-bit rounding (the renderer's
     // values: image = round(clamp(rgb + (1 - a) * background) * 255)), when FrameSpec::keep_float.
     std::vector<float> rgba_float;
-    RenderStats stats;                    // the slicer fills seconds, samples, pixels
+    RenderStats stats;  // the slicer fills seconds, samples, pixels
     // What this frame did besides rendering.
     double build_seconds = 0;    // built the frame's structure (0: it was built before)
     double tf_sync_seconds = 0;  // brought the structure to the current TF (0: it held it)
@@ -64,7 +64,7 @@ struct FrameResult {
 };
 
 class Session {
-public:
+  public:
     // threads: render and build threads (0 = all hardware threads).
     explicit Session(Volume volume, int threads = 0);
     ~Session();
@@ -120,7 +120,7 @@ public:
     const Accel* built_structure(const FrameSpec& spec) const;
     const BoxSource* built_box_source(const FrameSpec& spec) const;
 
-private:
+  private:
     void check_tfs(const FrameSpec& spec) const;
     // prepare()'s part for each renderer, and the intensity structure two of them share.
     void prepare_marcher(const FrameSpec& spec, FrameResult& out);

@@ -122,7 +122,7 @@ bool lut_range_ok(ValueRange vis, int size = kDefaultLutSize);
 void check_lut_range(ValueRange vis, int size, const std::string& where, const std::string& field);
 
 class ValueToLut {
-public:
+  public:
     ValueToLut() = default;
     // For a range with lut_range_ok: the exact map, bit for bit the formula in the header
     // comment. Otherwise (a range no boundary accepts) still total and monotone: a non-finite
@@ -150,7 +150,7 @@ public:
     float scale() const { return m_scale; }
     int last() const { return m_last; }
 
-private:
+  private:
     float m_min = 0, m_scale = 1;
     int m_last = 0;
 };

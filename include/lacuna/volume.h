@@ -30,11 +30,24 @@ std::string to_string(VoxelType t);
 VoxelType parse_voxel_type(const std::string& name, const std::string& where = "type");
 size_t voxel_size(VoxelType t);
 
-template <class T> constexpr VoxelType voxel_type_of();
-template <> constexpr VoxelType voxel_type_of<uint8_t>() { return VoxelType::UInt8; }
-template <> constexpr VoxelType voxel_type_of<int16_t>() { return VoxelType::Int16; }
-template <> constexpr VoxelType voxel_type_of<uint16_t>() { return VoxelType::UInt16; }
-template <> constexpr VoxelType voxel_type_of<float>() { return VoxelType::Float32; }
+template <class T>
+constexpr VoxelType voxel_type_of();
+template <>
+constexpr VoxelType voxel_type_of<uint8_t>() {
+    return VoxelType::UInt8;
+}
+template <>
+constexpr VoxelType voxel_type_of<int16_t>() {
+    return VoxelType::Int16;
+}
+template <>
+constexpr VoxelType voxel_type_of<uint16_t>() {
+    return VoxelType::UInt16;
+}
+template <>
+constexpr VoxelType voxel_type_of<float>() {
+    return VoxelType::Float32;
+}
 
 struct ValueRange {
     float min = 0.f, max = 0.f;
@@ -46,7 +59,7 @@ struct ValueRange {
 inline constexpr int kMaxDim = 32768;
 
 class Volume {
-public:
+  public:
     Volume() = default;
     // Allocates dims.x*dims.y*dims.z voxels (zeroed). `where` names the source in errors.
     // Throws lacuna::Error for dims < 2, > kMaxDim, or more bytes than physical memory.
@@ -56,9 +69,7 @@ public:
 
     Vec3i dims() const { return m_dims; }
     VoxelType type() const { return m_type; }
-    size_t voxel_count() const {
-        return size_t(m_dims.x) * size_t(m_dims.y) * size_t(m_dims.z);
-    }
+    size_t voxel_count() const { return size_t(m_dims.x) * size_t(m_dims.y) * size_t(m_dims.z); }
     size_t bytes() const { return voxel_count() * voxel_size(m_type); }
     size_t index(int i, int j, int k) const {
         return (size_t(k) * size_t(m_dims.y) + size_t(j)) * size_t(m_dims.x) + size_t(i);
@@ -66,8 +77,14 @@ public:
 
     void* data() { return m_data; }
     const void* data() const { return m_data; }
-    template <class T> T* data_as() { return static_cast<T*>(m_data); }
-    template <class T> const T* data_as() const { return static_cast<const T*>(m_data); }
+    template <class T>
+    T* data_as() {
+        return static_cast<T*>(m_data);
+    }
+    template <class T>
+    const T* data_as() const {
+        return static_cast<const T*>(m_data);
+    }
 
     // Voxel value converted to float (slow path: tests, info, generators).
     float value(int i, int j, int k) const;
@@ -106,7 +123,7 @@ public:
     // Physical extent of the sampled region [0, dims-1] * spacing (world units).
     Vec3f world_extent() const;
 
-private:
+  private:
     Vec3i m_dims{0, 0, 0};
     VoxelType m_type = VoxelType::UInt8;
     std::shared_ptr<void> m_owner;
@@ -123,10 +140,14 @@ std::string to_string(const Volume& v);
 template <class F>
 decltype(auto) visit_voxels(const Volume& v, F&& f) {
     switch (v.type()) {
-        case VoxelType::UInt8: return f(v.data_as<uint8_t>());
-        case VoxelType::Int16: return f(v.data_as<int16_t>());
-        case VoxelType::UInt16: return f(v.data_as<uint16_t>());
-        default: return f(v.data_as<float>());
+        case VoxelType::UInt8:
+            return f(v.data_as<uint8_t>());
+        case VoxelType::Int16:
+            return f(v.data_as<int16_t>());
+        case VoxelType::UInt16:
+            return f(v.data_as<uint16_t>());
+        default:
+            return f(v.data_as<float>());
     }
 }
 

@@ -526,7 +526,8 @@ lacuna::LabelTable label_table_of(PySession& ps, py::object style) {
                    .attr("dumps")(style, "allow_nan"_a = false)
                    .cast<std::string>();
     } catch (py::error_already_set& e) {
-        value_error("label_style", "labels", std::string("expected JSON values (") + e.what() + ")");
+        value_error("label_style", "labels",
+                    std::string("expected JSON values (") + e.what() + ")");
     }
     py::module_ tempfile = py::module_::import("tempfile");
     py::object dir = tempfile.attr("TemporaryDirectory")();
@@ -838,11 +839,10 @@ py::tuple render(PySession& ps, py::kwargs kwargs) {
         r.build_seconds += built.build_seconds;  // what this call built, before the frame
         r.tf_sync_seconds += built.tf_sync_seconds;
         if (req.spec.renderer != lacuna::Renderer::Slicer)
-            lattice = LatticeCount{req.spec.renderer == lacuna::Renderer::Segments
-                                       ? ps.session->label_volume()
-                                       : ps.session->volume(),
-                                   ps.session->camera(req.spec), req.spec.sampling.step,
-                                   ps.session->threads()};
+            lattice = LatticeCount{
+                req.spec.renderer == lacuna::Renderer::Segments ? ps.session->label_volume()
+                                                                : ps.session->volume(),
+                ps.session->camera(req.spec), req.spec.sampling.step, ps.session->threads()};
     }
     py::dict stats = stats_of(r);
     py::array image8 = image_array(std::move(r.image));

@@ -46,7 +46,9 @@ Interpolation parse_interpolation(const std::string& name) {
                      "unknown '" + name + "'; expected one of: trilinear, nearest");
 }
 
-AccelKind default_accel() { return AccelKind::Grid; }
+AccelKind default_accel() {
+    return AccelKind::Grid;
+}
 
 AccelKind parse_accel(const std::string& name) {
     if (name == "auto") return default_accel();

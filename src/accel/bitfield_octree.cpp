@@ -21,7 +21,8 @@ BitfieldOctree::BitfieldOctree(const Volume& v, const AccelOptions& o)
     : OctreeBase(AccelKind::Bitfield, v, o) {
     const int b = o.bitfield_bits;
     if (b != 8 && b != 16 && b != 32 && b != 64 && b != 128)
-        throw FrameError("structure.bits", "expected 8, 16, 32, 64 or 128, got " + std::to_string(b));
+        throw FrameError("structure.bits",
+                         "expected 8, 16, 32, 64 or 128, got " + std::to_string(b));
     m_nbits = b;
     m_words = b > 64 ? 2 : 1;
     m_interpolation = o.interpolation;
@@ -42,10 +43,12 @@ void BitfieldOctree::build_nearest_leaves() {
             for (int lz = int(z0); lz < int(z1); ++lz)
                 for (int ly = 0; ly < nl[1]; ++ly) {
                     uint64_t* row = &m_bits[m_pyr.index(0, 0, ly, lz) * size_t(W)];
-                    const int k1 = std::min((lz + 1) << L, d.z - 1), j1 = std::min((ly + 1) << L, d.y - 1);
+                    const int k1 = std::min((lz + 1) << L, d.z - 1),
+                              j1 = std::min((ly + 1) << L, d.y - 1);
                     for (int k = lz << L; k <= k1; ++k)
                         for (int j = ly << L; j <= j1; ++j) {
-                            const auto* v = data + (size_t(k) * size_t(d.y) + size_t(j)) * size_t(d.x);
+                            const auto* v =
+                                data + (size_t(k) * size_t(d.y) + size_t(j)) * size_t(d.x);
                             for (int i = 0; i < d.x; ++i) bins[size_t(i)] = bin(m_map(float(v[i])));
                             // Voxel i is a corner of the cells i - 1 and i: of leaf i / B, and
                             // of leaf i / B - 1 when it starts that leaf.

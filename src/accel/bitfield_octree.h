@@ -21,7 +21,7 @@
 namespace lacuna {
 
 class BitfieldOctree final : public OctreeBase {
-public:
+  public:
     BitfieldOctree(const Volume& v, const AccelOptions& o);
     void set_transfer_function(const TransferLut& lut) override;
     Region region(const int cell[3], int& hint) const {
@@ -64,7 +64,7 @@ public:
     // The TF bitfield (tests, the viewer's overlay).
     const uint64_t* tf_bits() const { return m_tf; }
 
-private:
+  private:
     void build();
     void build_range_leaves();
     void build_nearest_leaves();

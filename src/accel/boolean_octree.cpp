@@ -20,7 +20,8 @@ void BooleanOctree::set_transfer_function(const TransferLut& lut) {
     std::fill(m_occupied.begin(), m_occupied.end(), 0);
     const int B = 1 << m_pyr.leaf_log2;
     for_each_cell_chunk_row(m_volume, m_map, B, m_opts.threads, [&](const CellChunkRow& r) {
-        uint8_t* leaf = &m_occupied[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2)];
+        uint8_t* leaf =
+            &m_occupied[m_pyr.index(0, 0, r.j >> m_pyr.leaf_log2, r.k >> m_pyr.leaf_log2)];
         uint16_t lo[64], hi[64];
         for (int q = 0, i0 = 0; i0 < r.n; ++q, i0 += B, ++leaf) {
             // A chunk whose union is invisible has no visible cell; otherwise ask each cell

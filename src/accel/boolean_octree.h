@@ -14,7 +14,7 @@
 namespace lacuna {
 
 class BooleanOctree final : public OctreeBase {
-public:
+  public:
     BooleanOctree(const Volume& v, const AccelOptions& o);
     void set_transfer_function(const TransferLut& lut) override;
     Region region(const int cell[3], int& hint) const {
@@ -23,7 +23,7 @@ public:
     }
     using Cursor = RegionCursor<BooleanOctree>;
 
-private:
+  private:
     std::vector<uint8_t> m_occupied;
 };
 

@@ -86,9 +86,11 @@ void BrickGrid::build_nearest_bins() {
                             else
                                 row[size_t(i)] = bit_of(float(v[i]));
                         }
-                        uint64_t* out = &xmask[(size_t(k - k0) * size_t(d.y) + size_t(j)) * size_t(nbx)];
+                        uint64_t* out =
+                            &xmask[(size_t(k - k0) * size_t(d.y) + size_t(j)) * size_t(nbx)];
                         for (int bx = 0; bx < nbx; ++bx) {
-                            const int i0 = std::max(B * bx - 1, 0), i1 = std::min(B * bx + B + 1, d.x - 1);
+                            const int i0 = std::max(B * bx - 1, 0),
+                                      i1 = std::min(B * bx + B + 1, d.x - 1);
                             uint64_t m = 0;
                             for (int i = i0; i <= i1; ++i) m |= row[size_t(i)];
                             out[bx] = m;
@@ -100,7 +102,9 @@ void BrickGrid::build_nearest_bins() {
                         uint64_t m = 0;
                         for (int k = k0; k <= k1; ++k)
                             for (int j = j0; j <= j1; ++j)
-                                m |= xmask[(size_t(k - k0) * size_t(d.y) + size_t(j)) * size_t(nbx) + size_t(bx)];
+                                m |=
+                                    xmask[(size_t(k - k0) * size_t(d.y) + size_t(j)) * size_t(nbx) +
+                                          size_t(bx)];
                         m_bins[slot(bx, by, bz)] = m;
                     }
                 }
@@ -192,7 +196,8 @@ static void octant_distances(const int nf[3], const uint16_t* near, int threads,
                         const uint16_t e = near[row + size_t(fx)];
                         int d = 0;
                         if (e & 0xff) {
-                            int m = std::min({c[x + 1], cy[x], cy[x + 1], cz[x], cz[x + 1], cyz[x], cyz[x + 1]});
+                            int m = std::min(
+                                {c[x + 1], cy[x], cy[x + 1], cz[x], cz[x + 1], cyz[x], cyz[x + 1]});
                             d = std::min(kCap, m + 1);
                         }
                         c[x] = uint8_t(d);
@@ -239,7 +244,8 @@ static void leap_sub_bricks(const Volume& v, const uint32_t* mask, const int nf[
         for (int bz = int(z0); bz < int(z1); ++bz)
             for (int by = 0; by < nf[1]; ++by)
                 for (int bx = 0; bx < nf[0]; ++bx) {
-                    const size_t i = (size_t(bz) * size_t(nf[1]) + size_t(by)) * size_t(nf[0]) + size_t(bx);
+                    const size_t i =
+                        (size_t(bz) * size_t(nf[1]) + size_t(by)) * size_t(nf[0]) + size_t(bx);
                     uint16_t& e = leap[i];
                     if (e != 0) continue;
                     if (all_visible(i)) {
@@ -254,14 +260,16 @@ static void leap_sub_bricks(const Volume& v, const uint32_t* mask, const int nf[
                         for (int pj = 0; pj < 6; ++pj) {
                             const int j = 4 * by - 1 + pj;
                             if (j < 0 || j >= cells[1]) continue;
-                            const unsigned row = bits(size_t(k) * sz + size_t(j) * sy + size_t(x0), x1 - x0 + 1)
-                                                 << (x0 - (4 * bx - 1));
+                            const unsigned row =
+                                bits(size_t(k) * sz + size_t(j) * sy + size_t(x0), x1 - x0 + 1)
+                                << (x0 - (4 * bx - 1));
                             const unsigned m = (row & 0x0fu ? 1u : 0u) | (row & 0x3cu ? 2u : 0u);
                             if (!m) continue;
                             const int hy = halves(pj), hz = halves(pk);
                             for (int qz = 0; qz < 2; ++qz)
                                 for (int qy = 0; qy < 2; ++qy)
-                                    if ((hz >> qz & 1) && (hy >> qy & 1)) sub |= m << (2 * qy + 4 * qz);
+                                    if ((hz >> qz & 1) && (hy >> qy & 1))
+                                        sub |= m << (2 * qy + 4 * qz);
                         }
                     }
                     e = uint16_t(sub << 8);
@@ -277,13 +285,14 @@ void BrickGrid::refine() {
     const auto t0 = std::chrono::steady_clock::now();
     // A brick is 0 (empty), 2 when every entry of its apron range is visible (so is every
     // cell's range, which it contains), else 1.
-    visible_cell_mask(m_volume, m_map, m_next_visible.data(), 1 << m_log2,
-                      [&](int x, int y, int z) {
-                          if (!occupied(x, y, z)) return 0;
-                          const size_t i = slot(x, y, z);
-                          return m_next_invisible[m_lo[i]] > m_hi[i] ? 2 : 1;
-                      },
-                      m_opts.threads, m_mask);
+    visible_cell_mask(
+        m_volume, m_map, m_next_visible.data(), 1 << m_log2,
+        [&](int x, int y, int z) {
+            if (!occupied(x, y, z)) return 0;
+            const size_t i = slot(x, y, z);
+            return m_next_invisible[m_lo[i]] > m_hi[i] ? 2 : 1;
+        },
+        m_opts.threads, m_mask);
     m_mask_ready = true;
     // The leap map: fine bricks' apron ranges (TF-independent, made on the first refine), their
     // occupancy under this TF, and its Chebyshev distances.
@@ -297,8 +306,9 @@ void BrickGrid::refine() {
     std::vector<uint16_t> near(n + 1, 0);
     for (size_t i = 0; i < n; ++i) near[i] = next[m_fine_lo[i]] <= m_fine_hi[i] ? 0 : 1;
     const uint16_t* next_invisible = m_next_invisible.data();
-    leap_sub_bricks(m_volume, m_mask.data(), m_nf, m_opts.threads,
-                    [&](size_t i) { return next_invisible[m_fine_lo[i]] > m_fine_hi[i]; }, near);
+    leap_sub_bricks(
+        m_volume, m_mask.data(), m_nf, m_opts.threads,
+        [&](size_t i) { return next_invisible[m_fine_lo[i]] > m_fine_hi[i]; }, near);
     m_leap.assign(8 * n + 1, 0);  // padding: kernels read 32-bit words
     octant_distances(m_nf, near.data(), m_opts.threads, m_leap.data());
     m_stats.refine_seconds =

@@ -46,7 +46,7 @@
 namespace lacuna {
 
 class BrickGrid final : public OctreeBase {
-public:
+  public:
     BrickGrid(const Volume& v, const AccelOptions& o);
     void set_transfer_function(const TransferLut& lut) override;
     // The fine level: the visible-cell mask of the current TF (visible_cell_mask in
@@ -75,7 +75,9 @@ public:
     static constexpr int kLeapLog2 = 2;
     const uint16_t* leap_map() const { return m_mask_ready ? m_leap.data() : nullptr; }
     const int* leap_dims() const { return m_nf; }
-    size_t leap_octant_stride() const { return size_t(m_nf[0]) * size_t(m_nf[1]) * size_t(m_nf[2]); }
+    size_t leap_octant_stride() const {
+        return size_t(m_nf[0]) * size_t(m_nf[1]) * size_t(m_nf[2]);
+    }
 
     int brick_log2() const { return m_log2; }
     const int* bricks() const { return m_nb; }
@@ -109,7 +111,7 @@ public:
 
     class Cursor;
 
-private:
+  private:
     void build();
     void compute_distances();
     size_t slot(int x, int y, int z) const {
@@ -132,7 +134,7 @@ private:
     std::vector<uint64_t> m_words;
     std::vector<uint16_t> m_block_lo, m_block_hi;  // per block: union of its bricks' ranges
     std::vector<uint8_t> m_dist;  // per block: Chebyshev distance to an occupied block, 1..255
-    std::vector<uint16_t> m_next_visible;  // per LUT entry: the first visible entry >= it
+    std::vector<uint16_t> m_next_visible;    // per LUT entry: the first visible entry >= it
     std::vector<uint16_t> m_next_invisible;  // per LUT entry: the first invisible entry >= it
     // Built for Interpolation::Nearest: per brick (slot order) the set of 64 LUT-entry bins of its
     // apron voxels, and the bins of the TF's visible entries (see build_nearest_bins).
@@ -152,13 +154,16 @@ private:
 // with the state in registers, tested to hand out the same stretches to the bit. Empty blocks
 // are left in one leap.
 class BrickGrid::Cursor {
-public:
+  public:
     // min_skip: empty stretches not longer than this stay in the run (world units). chunk: an
     // occupied stretch is handed out once this long (0 = never), so early ray termination does
     // not pay for walking to the far side.
     Cursor(const BrickGrid& g, const IndexRay& r, float t_near, float t_far, float min_skip = 0.f,
            float chunk = 0.f)
-        : m_g(g), m_t(t_near), m_far(t_far), m_min_skip(min_skip),
+        : m_g(g),
+          m_t(t_near),
+          m_far(t_far),
+          m_min_skip(min_skip),
           m_chunk(chunk > 0.f ? chunk : INFINITY) {
         const int L = g.m_log2;
         for (int a = 0; a < 3; ++a) {
@@ -348,7 +353,7 @@ public:
         return emit;
     }
 
-private:
+  private:
     static int argmin(const float t[3]) {
         const int a = t[1] < t[0] ? 1 : 0;
         return t[2] < t[a] ? 2 : a;

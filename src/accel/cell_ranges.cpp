@@ -48,8 +48,12 @@ struct VoxelLut {
         hi = uint16_t(map(x + w));
     }
     // Integer voxels only: the table bounds of one value.
-    uint16_t lower(T x) const { return lo_table[size_t(int(x) - int(std::numeric_limits<T>::min()))]; }
-    uint16_t upper(T x) const { return hi_table[size_t(int(x) - int(std::numeric_limits<T>::min()))]; }
+    uint16_t lower(T x) const {
+        return lo_table[size_t(int(x) - int(std::numeric_limits<T>::min()))];
+    }
+    uint16_t upper(T x) const {
+        return hi_table[size_t(int(x) - int(std::numeric_limits<T>::min()))];
+    }
     void bounds(T x, uint16_t& lo, uint16_t& hi) const {
         if constexpr (kTable) {
             const size_t e = size_t(int(x) - int(std::numeric_limits<T>::min()));
@@ -315,7 +319,8 @@ void apron_typed(const Volume& v, const T* data, ValueToLut map, int edge, int t
                         lo_row = row;
                         hi_row = row;
                     } else {
-                        for (int i = 0; i < d.x; ++i) vl.bounds(row[i], flo[size_t(i)], fhi[size_t(i)]);
+                        for (int i = 0; i < d.x; ++i)
+                            vl.bounds(row[i], flo[size_t(i)], fhi[size_t(i)]);
                         lo_row = flo.data();
                         hi_row = fhi.data();
                     }
@@ -418,8 +423,10 @@ void mask_typed(const Volume& v, const T* data, ValueToLut map, const uint16_t* 
                         continue;
                     }
                     for (int x = i0; x <= i1; ++x) {
-                        cmin[size_t(x)] = std::min(std::min(r00[x], r10[x]), std::min(r01[x], r11[x]));
-                        cmax[size_t(x)] = std::max(std::max(r00[x], r10[x]), std::max(r01[x], r11[x]));
+                        cmin[size_t(x)] =
+                            std::min(std::min(r00[x], r10[x]), std::min(r01[x], r11[x]));
+                        cmax[size_t(x)] =
+                            std::max(std::max(r00[x], r10[x]), std::max(r01[x], r11[x]));
                     }
                     for (int i = i0; i < i1; ++i) {
                         const T a = std::min(cmin[size_t(i)], cmin[size_t(i) + 1]);
@@ -463,8 +470,7 @@ void for_each_cell_row(const Volume& v, ValueToLut map, int slab, int threads,
 
 void for_each_cell_chunk_row(const Volume& v, ValueToLut map, int chunk, int threads,
                              const std::function<void(const CellChunkRow&)>& fn) {
-    visit_voxels(v,
-                 [&](const auto* data) { rows_typed(v, data, map, chunk, chunk, threads, fn); });
+    visit_voxels(v, [&](const auto* data) { rows_typed(v, data, map, chunk, chunk, threads, fn); });
 }
 
 void for_each_block_cells(const Volume& v, ValueToLut map, int edge, int threads,

@@ -92,7 +92,7 @@ inline void cell_counts(const Volume& v, int cells[3]) {
 // Prefix count of LUT entries with non-zero opacity: visible(lo, hi) in O(1) (min-max paper
 // trick).
 class OpacityPrefix {
-public:
+  public:
     void build(const TransferLut& lut) {
         m_prefix.assign(lut.entries.size() + 1, 0);
         for (size_t e = 0; e < lut.entries.size(); ++e)
@@ -100,7 +100,7 @@ public:
     }
     bool visible(int lo, int hi) const { return m_prefix[size_t(hi) + 1] != m_prefix[size_t(lo)]; }
 
-private:
+  private:
     std::vector<uint32_t> m_prefix;
 };
 

@@ -7,10 +7,10 @@
 // kMargin), so their trilinear cell is one of the region's empty cells. A face on the grid's
 // border needs no margin: the sampler clamps positions into the grid, so a position past that
 // face still reads the border cell, which is the region's. (Without this, every ray kept about
-// one sample at each end of the volume even when the whole volume is empty.) Everything else of [t_near, t_far] is returned, so the ray
-// marcher (which rounds segments outward to lattice samples) takes every sample the reference
-// takes that could be visible. How the cursor walks (nudges, minimum advances) affects speed,
-// never the image.
+// one sample at each end of the volume even when the whole volume is empty.) Everything else of
+// [t_near, t_far] is returned, so the ray marcher (which rounds segments outward to lattice
+// samples) takes every sample the reference takes that could be visible. How the cursor walks
+// (nudges, minimum advances) affects speed, never the image.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -27,7 +27,7 @@ struct Segment {
 // const int* cells() const (cells per axis, dims - 1).
 template <class S>
 class RegionCursor {
-public:
+  public:
     static constexpr float kMargin = 0.05f;  // voxels
 
     // min_skip: empty stretches shorter than this (world units) are not cut out; the renderer
@@ -117,7 +117,7 @@ public:
         return out.t1 > out.t0;
     }
 
-private:
+  private:
     const S& m_s;
     IndexRay m_r;
     float m_t, m_far, m_seg_start;

@@ -51,8 +51,7 @@ void edt_1d(const float* f, float* d, int n, int* v, float* z) {
 
 DistanceMap::DistanceMap(AccelKind kind, const Volume& v, const AccelOptions& o)
     : Accel(kind), m_volume(v), m_opts(o), m_block(o.distance_block) {
-    if (m_block < 1 || m_block > 64)
-        throw FrameError("structure.block", "expected 1..64 cells");
+    if (m_block < 1 || m_block > 64) throw FrameError("structure.block", "expected 1..64 cells");
     cell_counts(v, m_cells);
     for (int a = 0; a < 3; ++a) m_nb[a] = (m_cells[a] + m_block - 1) / m_block;
     m_radius.assign(size_t(m_nb[0]) * m_nb[1] * m_nb[2], 0);
@@ -95,7 +94,8 @@ void DistanceMap::set_transfer_function(const TransferLut& lut) {
                     for (int dy = -1; dy <= 1; ++dy)
                         for (int dx = -1; dx <= 1; ++dx) {
                             const int X = x + dx, Y = y + dy, Z = z + dz;
-                            if (X < 0 || Y < 0 || Z < 0 || X >= int(nx) || Y >= int(ny) || Z >= int(nz))
+                            if (X < 0 || Y < 0 || Z < 0 || X >= int(nx) || Y >= int(ny) ||
+                                Z >= int(nz))
                                 continue;
                             const size_t j = (size_t(Z) * ny + Y) * nx + X;
                             if (dist[j] == kFar) dist[j] = level, next.push_back(uint32_t(j));
@@ -125,7 +125,8 @@ void DistanceMap::set_transfer_function(const TransferLut& lut) {
                     const size_t base = a * stride[o1] + b * stride[o2];
                     for (int q = 0; q < len; ++q) in[size_t(q)] = f[base + size_t(q) * stride[ax]];
                     edt_1d(in.data(), out.data(), len, v.data(), z.data());
-                    for (int q = 0; q < len; ++q) f[base + size_t(q) * stride[ax]] = std::min(out[size_t(q)], inf);
+                    for (int q = 0; q < len; ++q)
+                        f[base + size_t(q) * stride[ax]] = std::min(out[size_t(q)], inf);
                 }
             });
         }

@@ -22,7 +22,7 @@
 namespace lacuna {
 
 class DistanceMap final : public Accel {
-public:
+  public:
     DistanceMap(AccelKind kind, const Volume& v, const AccelOptions& o);
     void set_transfer_function(const TransferLut& lut) override;
     const int* cells() const { return m_cells; }
@@ -41,7 +41,7 @@ public:
     }
     using Cursor = RegionCursor<DistanceMap>;
 
-private:
+  private:
     const Volume& m_volume;
     AccelOptions m_opts;
     int m_cells[3];

@@ -19,8 +19,8 @@ namespace lacuna {
 
 template <class S>
 concept HasEntryWindow = requires(const S& s, const int* c, int& h) {
-    { s.region_outside(c, h, 0, 0) };
-    { s.value_map() };
+    {s.region_outside(c, h, 0, 0)};
+    {s.value_map()};
 };
 
 // A structure seen through a window of LUT entries the marcher updates between cursor steps:
@@ -31,7 +31,9 @@ struct EntryWindowView {
     const int* lo;
     const int* hi;
     const int* cells() const { return s->cells(); }
-    Region region(const int cell[3], int& hint) const { return s->region_outside(cell, hint, *lo, *hi); }
+    Region region(const int cell[3], int& hint) const {
+        return s->region_outside(cell, hint, *lo, *hi);
+    }
 };
 
 inline bool same_map(const ValueToLut& a, const ValueToLut& b) {

@@ -137,8 +137,8 @@ KdSettings kd_settings(const AccelOptions& o) {
         throw FrameError("structure.max_boxes",
                          "expected >= 0 (0 = every leaf), got " + std::to_string(o.kd_max_boxes));
     if (o.kd_delta < 0)
-        throw FrameError("structure.delta",
-                         "expected >= 1 cells (0 = from the size), got " + std::to_string(o.kd_delta));
+        throw FrameError("structure.delta", "expected >= 1 cells (0 = from the size), got " +
+                                                std::to_string(o.kd_delta));
     if (!(o.kd_min_volume >= 0.f && o.kd_min_volume <= 1.f))
         throw FrameError("structure.min_volume",
                          "expected 0..1, got " + std::to_string(o.kd_min_volume));

@@ -24,7 +24,7 @@
 namespace lacuna {
 
 class LabelOctree {
-public:
+  public:
     // labels: an integer label map (check_label_volume). intensity: optional, same dims.
     LabelOctree(const Volume& labels, const Volume* intensity, const SegmentOptions& o);
     // Masked mode: the intensity TF.
@@ -51,7 +51,7 @@ public:
     const uint64_t* node_bits(size_t i) const { return &m_bits[i * size_t(m_words)]; }
     const Pyramid& pyramid() const { return m_pyr; }
 
-private:
+  private:
     Pyramid m_pyr;
     int m_words = 1;
     std::vector<uint64_t> m_bits;     // node-major, m_words per node

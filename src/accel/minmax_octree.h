@@ -19,7 +19,7 @@
 namespace lacuna {
 
 class MinMaxOctree final : public OctreeBase {
-public:
+  public:
     struct Node {
         uint16_t lo, hi;
     };
@@ -45,7 +45,7 @@ public:
         });
     }
 
-private:
+  private:
     void build();
     std::vector<Node> m_nodes;
     OpacityPrefix m_prefix;

@@ -6,14 +6,13 @@
 namespace lacuna {
 
 class NoAccel final : public Accel {
-public:
+  public:
     NoAccel() : Accel(AccelKind::None) {}
     void set_transfer_function(const TransferLut&) override {}
 
     class Cursor {
-    public:
-        Cursor(const NoAccel&, const IndexRay&, float t_near, float t_far, float = 0.f,
-               float = 0.f)
+      public:
+        Cursor(const NoAccel&, const IndexRay&, float t_near, float t_far, float = 0.f, float = 0.f)
             : m_seg{t_near, t_far} {}
         bool next(Segment& out) {
             if (m_done) return false;
@@ -22,7 +21,7 @@ public:
             return true;
         }
 
-    private:
+      private:
         Segment m_seg;
         bool m_done = false;
     };

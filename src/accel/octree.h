@@ -37,7 +37,8 @@ struct Pyramid {
         for (;;) {
             const int s = leaf_log2 + levels;
             for (int a = 0; a < 3; ++a) n[levels][a] = int((int64_t(cells[a]) + (1 << s) - 1) >> s);
-            offset[levels + 1] = offset[levels] + size_t(n[levels][0]) * n[levels][1] * n[levels][2];
+            offset[levels + 1] =
+                offset[levels] + size_t(n[levels][0]) * n[levels][1] * n[levels][2];
             ++levels;
             if (n[levels - 1][0] == 1 && n[levels - 1][1] == 1 && n[levels - 1][2] == 1) break;
         }

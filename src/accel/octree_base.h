@@ -8,18 +8,20 @@
 namespace lacuna {
 
 class OctreeBase : public Accel {
-public:
+  public:
     const int* cells() const { return m_pyr.cells; }
     const Pyramid& pyramid() const { return m_pyr; }
     // The value -> LUT entry map the structure's ranges are in (that of the last TF).
     const ValueToLut& value_map() const { return m_map; }
 
-protected:
-    OctreeBase(AccelKind k, const Volume& v, const AccelOptions& o) : Accel(k), m_volume(v), m_opts(o) {
+  protected:
+    OctreeBase(AccelKind k, const Volume& v, const AccelOptions& o)
+        : Accel(k), m_volume(v), m_opts(o) {
         int c[3];
         cell_counts(v, c);
         m_pyr.init(c, o.leaf_cells);
-        m_start = o.initial_level < 0 ? m_pyr.levels - 1 : std::min(o.initial_level, m_pyr.levels - 1);
+        m_start =
+            o.initial_level < 0 ? m_pyr.levels - 1 : std::min(o.initial_level, m_pyr.levels - 1);
         m_map = ValueToLut(v.vis_range(), kDefaultLutSize);
         m_vis = v.vis_range();
         m_lut_size = kDefaultLutSize;

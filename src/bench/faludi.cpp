@@ -65,7 +65,8 @@ StructureResult build_structure(AccelKind k, const BenchDataset& d, const Faludi
     s.tf_change_ms = tf.empty() ? 0 : percentile(tf, 50);
     if (o.refine) {
         session.refine();
-        if (const Accel* a = session.built_structure(frame)) s.refine_ms = a->stats().refine_seconds * 1e3;
+        if (const Accel* a = session.built_structure(frame))
+            s.refine_ms = a->stats().refine_seconds * 1e3;
     }
     if (const Accel* a = session.built_structure(frame)) {
         s.bytes = a->stats().bytes;
@@ -135,8 +136,9 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
     for (RowResult& row : out.rows) {
         if (log) log("  " + d.name + " " + to_string(row.mode) + " none ...");
         reference.push_back(Image{});
-        CellResult c = run_cell(AccelKind::None, session, row_frames(o, row.mode, session, AccelKind::None),
-                                nullptr, &reference.back());
+        CellResult c =
+            run_cell(AccelKind::None, session, row_frames(o, row.mode, session, AccelKind::None),
+                     nullptr, &reference.back());
         c.exact = true;
         c.speedup = c.sample_reduction = 1;
         row.cells.push_back(c);
@@ -217,20 +219,28 @@ DatasetResult run_dataset(const BenchDataset& d, const FaludiOptions& o, const L
 
 std::string to_string(RowMode m) {
     switch (m) {
-        case RowMode::MarchingOnly: return "Marching only";
-        case RowMode::EarlyExit: return "+ Early exit";
-        case RowMode::Shading: return "+ Shading";
-        case RowMode::Lighting: return "+ Lighting";
+        case RowMode::MarchingOnly:
+            return "Marching only";
+        case RowMode::EarlyExit:
+            return "+ Early exit";
+        case RowMode::Shading:
+            return "+ Shading";
+        case RowMode::Lighting:
+            return "+ Lighting";
     }
     return "?";
 }
 
 std::string csv_name(RowMode m) {
     switch (m) {
-        case RowMode::MarchingOnly: return "marching_only";
-        case RowMode::EarlyExit: return "early_exit";
-        case RowMode::Shading: return "shading";
-        case RowMode::Lighting: return "lighting";
+        case RowMode::MarchingOnly:
+            return "marching_only";
+        case RowMode::EarlyExit:
+            return "early_exit";
+        case RowMode::Shading:
+            return "shading";
+        case RowMode::Lighting:
+            return "lighting";
     }
     return "?";
 }
@@ -240,7 +250,8 @@ RowMode parse_row_mode(const std::string& name) {
     if (name == "early-exit") return RowMode::EarlyExit;
     if (name == "shading") return RowMode::Shading;
     if (name == "lighting") return RowMode::Lighting;
-    throw Error("--rows", "row", "unknown '" + name + "'; expected one of: marching, early-exit, shading, lighting");
+    throw Error("--rows", "row",
+                "unknown '" + name + "'; expected one of: marching, early-exit, shading, lighting");
 }
 
 RenderOptions row_render_options(const FaludiOptions& o, RowMode m, const Box3f& bounds) {

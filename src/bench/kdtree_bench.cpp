@@ -27,7 +27,7 @@ struct KdName {
     const char* name;
 };
 constexpr KdName kKdNames[] = {
-    {DatasetId::Ch2Skin, "ch2"},   {DatasetId::Ch2betterBrain, "ch2better"},
+    {DatasetId::Ch2Skin, "ch2"},        {DatasetId::Ch2betterBrain, "ch2better"},
     {DatasetId::Ch2betBrain, "ch2bet"}, {DatasetId::Aal, "aal"},
     {DatasetId::Tree512, "tree"},
 };
@@ -135,8 +135,10 @@ HoleMap find_holes(const Volume& v, const TransferLut& lut, int threads) {
         frontier.swap(next);
     }
     for (uint8_t& c : h.cls) {
-        if (c == kUnknown) c = kHole, ++h.holes;
-        else if (c == kFull) ++h.non_empty;
+        if (c == kUnknown)
+            c = kHole, ++h.holes;
+        else if (c == kFull)
+            ++h.non_empty;
     }
     return h;
 }
@@ -158,7 +160,8 @@ KdDatasetResult run_kd_dataset(const BenchDataset& d, int size, const KdBenchOpt
     char line[512];
 
     // 1. Preprocessing, steps 1-3 (and 4 for every leaf), `repeats` times on one partition: the
-    //    table is kept between builds as on a TF change (the first build also pays its page faults).
+    //    table is kept between builds as on a TF change (the first build also pays its page
+    //    faults).
     AccelOptions ao = o.accel;
     ao.threads = o.threads;
     ao.kd_max_boxes = 0;
@@ -205,9 +208,9 @@ KdDatasetResult run_kd_dataset(const BenchDataset& d, int size, const KdBenchOpt
         throw Error("bench kdtree", "classification",
                     "hole map and kd-tree disagree on the non-empty cells (a bug)");
     if (log)
-        log("  " + out.name + ": interior holes " + fmt("%.2f", 100.0 * double(out.holes) /
-                                                                   double(out.cells)) +
-            "% of the cells (" + fmt("%.0f", ms_since(th)) + " ms)");
+        log("  " + out.name + ": interior holes " +
+            fmt("%.2f", 100.0 * double(out.holes) / double(out.cells)) + "% of the cells (" +
+            fmt("%.0f", ms_since(th)) + " ms)");
 
     // 3. The lists (step 4) and their space statistics.
     for (int m : o.max_boxes) {
@@ -298,7 +301,8 @@ KdBenchReport run_kd_bench(const KdBenchOptions& o, const KdLogFn& log,
     if (o.sizes.empty()) throw Error("--sizes", "list", "expected at least one size");
     if (o.max_boxes.empty()) throw Error("--max-boxes", "list", "expected at least one M");
     for (int n : o.sizes)
-        if (n < 3 || n > 1024) throw Error("--sizes", "size", "expected 3..1024, got " + std::to_string(n));
+        if (n < 3 || n > 1024)
+            throw Error("--sizes", "size", "expected 3..1024, got " + std::to_string(n));
     KdBenchReport rep;
     rep.options = o;
     // The templates, read once at their own resolution.
@@ -318,10 +322,9 @@ KdBenchReport run_kd_bench(const KdBenchOptions& o, const KdLogFn& log,
                 d = load_datasets({id}, src).front();
                 d.name = label;
             } else {
-                const auto it = std::find_if(originals.begin(), originals.end(),
-                                             [&](const BenchDataset& b) {
-                                                 return b.name == to_string(id);
-                                             });
+                const auto it =
+                    std::find_if(originals.begin(), originals.end(),
+                                 [&](const BenchDataset& b) { return b.name == to_string(id); });
                 const Volume& src = *it->volume;
                 auto vol = std::make_shared<const Volume>(
                     resample_trilinear(src, cube_dims(n), o.threads));
@@ -333,7 +336,9 @@ KdBenchReport run_kd_bench(const KdBenchOptions& o, const KdLogFn& log,
                                  vol, preset(it->tf_name));
             }
             const double prepare_s = ms_since(t0) * 1e-3;
-            if (log) log("dataset " + d.name + ": " + d.description + fmt(" (ready in %.1f s)", prepare_s));
+            if (log)
+                log("dataset " + d.name + ": " + d.description +
+                    fmt(" (ready in %.1f s)", prepare_s));
             KdDatasetResult r = run_kd_dataset(d, n, o, log);
             r.prepare_s = prepare_s;
             rep.datasets.push_back(std::move(r));
@@ -366,8 +371,7 @@ std::string kd_bench_markdown(const KdBenchReport& rep, const RunInfo& info) {
     const KdBenchOptions& o = rep.options;
     std::string out = "# lacuna bench kdtree: the kd-tree paper's measurements on our data\n\n";
     out += run_info_markdown(info);
-    out += "- Settings: kd-tree " +
-           to_string(kd_settings([&] {
+    out += "- Settings: kd-tree " + to_string(kd_settings([&] {
                AccelOptions a = o.accel;
                a.kd_max_boxes = 0;
                return a;
@@ -379,22 +383,25 @@ std::string kd_bench_markdown(const KdBenchReport& rep, const RunInfo& info) {
            std::to_string(o.orbit.views) + ", elevation " + fmt("%g", o.orbit.elevation_deg) +
            "°), step " + fmt("%g", o.step) + ", ERT " + (o.ert < 1 ? fmt("%g", o.ert) : "off") +
            ", threads " + (o.threads > 0 ? std::to_string(o.threads) : "all") + ".\n";
-    out += "- Templates are resampled trilinearly to n×n×n (src/volume/resample.h, same world "
-           "extent); tree volumes are generated at n³ (`lacuna generate tree`, seed " +
-           std::to_string(o.source.tree_seed) + ").\n\n";
+    out +=
+        "- Templates are resampled trilinearly to n×n×n (src/volume/resample.h, same world "
+        "extent); tree volumes are generated at n³ (`lacuna generate tree`, seed " +
+        std::to_string(o.source.tree_seed) + ").\n\n";
 
     out += "## Preprocessing (the paper's Table 1 time: steps 1–3) and memory\n\n";
-    out += "| dataset | dims, type | TF | cells | empty | nodes / leaves / depth | Δl | step 1 "
-           "classify [ms] | step 2 table [ms] | step 3 tree [ms] | 1–3 [ms] | target [ms] | "
-           "table [MiB] | tree [KiB] |\n";
+    out +=
+        "| dataset | dims, type | TF | cells | empty | nodes / leaves / depth | Δl | step 1 "
+        "classify [ms] | step 2 table [ms] | step 3 tree [ms] | 1–3 [ms] | target [ms] | "
+        "table [MiB] | tree [KiB] |\n";
     out += "|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     Target t_pre256{"steps 1–3 ≤ 50 ms at 256³ (2 cores)", "", false, true};
     Target t_pre512{"steps 1–3 ≤ 400 ms at 512³ (2 cores)", "", false, true};
     Target t_m16{"≥ 60% of the empty space removed with M ≤ 16 on ch2bet and tree", "", false,
                  true};
-    Target t_mem{"peak extra memory ≤ one 32-bit table of the classified grid (4 B per cell) + "
-                 "the tree",
-                 "", false, true};
+    Target t_mem{
+        "peak extra memory ≤ one 32-bit table of the classified grid (4 B per cell) + "
+        "the tree",
+        "", false, true};
     for (const KdDatasetResult& d : rep.datasets) {
         const double pre = d.preprocess_median_ms;
         std::string target = "—";
@@ -406,38 +413,40 @@ std::string kd_bench_markdown(const KdBenchReport& rep, const RunInfo& info) {
             t->met = t->met && pre <= limit;
             t->measured += (t->measured.empty() ? "" : ", ") + d.name + " " + fmt("%.1f", pre);
         }
-        out += "| " + d.name + " | " + dims_text(d.dims) + " " + lacuna::to_string(d.type) +
-               " | " + d.tf_name + " | " + fmt("%.1f M", double(d.cells) * 1e-6) + " | " +
+        out += "| " + d.name + " | " + dims_text(d.dims) + " " + lacuna::to_string(d.type) + " | " +
+               d.tf_name + " | " + fmt("%.1f M", double(d.cells) * 1e-6) + " | " +
                fmt("%.1f%%", d.empty_percent()) + " | " + std::to_string(d.nodes) + " / " +
                std::to_string(d.leaves) + " / " + std::to_string(d.depth) + " | " +
                std::to_string(d.delta) + " | " + fmt("%.1f", d.median.classify * 1e3) + " | " +
                fmt("%.1f", d.median.table * 1e3) + " | " + fmt("%.2f", d.median.tree * 1e3) +
-               " | **" + fmt("%.1f", pre) + "** | " + target + " | " + mib(d.table_bytes) +
-               " | " + fmt("%.1f", double(d.tree_bytes) / 1024) + " |\n";
+               " | **" + fmt("%.1f", pre) + "** | " + target + " | " + mib(d.table_bytes) + " | " +
+               fmt("%.1f", double(d.tree_bytes) / 1024) + " |\n";
         t_mem.any = true;
         const bool mem_ok = d.table_bytes <= 4 * d.cells;
         t_mem.met = t_mem.met && mem_ok;
         if (!mem_ok) t_mem.measured += d.name + " table " + mib(d.table_bytes) + " MiB; ";
     }
-    out += "\nStep 1 includes the row sums along x that start Eq. 5; step 2 completes Eq. 5 in "
-           "place. The table is the only full-size allocation; the tree is 48 B per node plus "
-           "the list.\n\n";
+    out +=
+        "\nStep 1 includes the row sums along x that start Eq. 5; step 2 completes Eq. 5 in "
+        "place. The table is the only full-size allocation; the tree is 48 B per node plus "
+        "the list.\n\n";
 
     out += "## Subvolumes, removed space and frame time per M\n\n";
-    out += "Removed = outside every box of the list. *Empty in boxes* = share of the boxes' "
-           "volume that is empty (still marched through). *Holes kept* = share of the interior "
-           "holes (empty cells with no empty 6-connected path to the grid's faces, e.g. the "
-           "ventricles) that lie inside the boxes: the paper's limitation (Section 4) — the "
-           "greedy cost never carves them out. Frames: mean over the orbit; speedup = none's "
-           "mean / kdtree's mean, measured in the same run.\n\n";
-    out += "| dataset | list | boxes | removed [% volume] | removed [% empty] | empty in boxes "
-           "[%] | holes kept [%] | kdtree [ms] | none [ms] | speedup | samples/ray (none) | "
-           "exact |\n";
+    out +=
+        "Removed = outside every box of the list. *Empty in boxes* = share of the boxes' "
+        "volume that is empty (still marched through). *Holes kept* = share of the interior "
+        "holes (empty cells with no empty 6-connected path to the grid's faces, e.g. the "
+        "ventricles) that lie inside the boxes: the paper's limitation (Section 4) — the "
+        "greedy cost never carves them out. Frames: mean over the orbit; speedup = none's "
+        "mean / kdtree's mean, measured in the same run.\n\n";
+    out +=
+        "| dataset | list | boxes | removed [% volume] | removed [% empty] | empty in boxes "
+        "[%] | holes kept [%] | kdtree [ms] | none [ms] | speedup | samples/ray (none) | "
+        "exact |\n";
     out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
     for (const KdDatasetResult& d : rep.datasets) {
         bool first = true;
-        const double none_spr =
-            d.none_rays ? double(d.none_samples) / double(d.none_rays) : 0.0;
+        const double none_spr = d.none_rays ? double(d.none_samples) / double(d.none_rays) : 0.0;
         const double holes_pct = d.cells ? 100.0 * double(d.holes) / double(d.cells) : 0;
         for (const KdListResult& l : d.lists) {
             out += "| " +
@@ -461,19 +470,23 @@ std::string kd_bench_markdown(const KdBenchReport& rep, const RunInfo& info) {
             if (best >= 0) {
                 t_m16.any = true;
                 t_m16.met = t_m16.met && best >= 60;
-                t_m16.measured += (t_m16.measured.empty() ? "" : ", ") + d.name + " " +
-                                  fmt("%.1f%%", best);
+                t_m16.measured +=
+                    (t_m16.measured.empty() ? "" : ", ") + d.name + " " + fmt("%.1f%%", best);
             }
         }
     }
 
-    out += "\n## Targets (issue 4; benchmarks, not tests)\n\n| target | measured | status |\n"
-           "|---|---|---|\n";
+    out +=
+        "\n## Targets (issue 4; benchmarks, not tests)\n\n| target | measured | status |\n"
+        "|---|---|---|\n";
     if (t_mem.any && t_mem.measured.empty())
         t_mem.measured = "every table is 4 B per cell (uint32 counts); tree and list a few KiB";
     for (const Target* t : {&t_pre256, &t_pre512, &t_m16, &t_mem}) {
         out += "| " + t->what + " | " + (t->any ? t->measured : std::string("no row")) + " | " +
-               (!t->any ? "not measured" : t->met ? "met" : "**MISSED**") + " |\n";
+               (!t->any  ? "not measured"
+                : t->met ? "met"
+                         : "**MISSED**") +
+               " |\n";
     }
     return out;
 }
@@ -498,9 +511,9 @@ std::string kd_bench_csv(const KdBenchReport& rep) {
                 d.depth, d.delta, d.median.classify * 1e3, d.median.table * 1e3,
                 d.median.tree * 1e3, d.preprocess_median_ms, d.table_bytes, d.tree_bytes,
                 l.max_boxes, l.boxes, (unsigned long long)l.listed_cells, l.removed_percent,
-                l.removed_empty_percent, l.empty_in_boxes_percent, l.holes_kept_percent,
-                l.list_ms, l.build_ms, l.frame_ms.mean, l.frame_ms.p99, d.none_ms.mean,
-                d.none_ms.p99, l.speedup, l.samples_per_ray(),
+                l.removed_empty_percent, l.empty_in_boxes_percent, l.holes_kept_percent, l.list_ms,
+                l.build_ms, l.frame_ms.mean, l.frame_ms.p99, d.none_ms.mean, d.none_ms.p99,
+                l.speedup, l.samples_per_ray(),
                 d.none_rays ? double(d.none_samples) / double(d.none_rays) : 0.0, int(l.exact));
             out += buf;
         }

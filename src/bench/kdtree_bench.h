@@ -31,15 +31,15 @@ std::vector<DatasetId> default_kd_datasets();  // ch2, ch2better, ch2bet, aal, t
 
 struct KdBenchOptions {
     std::vector<DatasetId> datasets = default_kd_datasets();
-    std::vector<int> sizes = {256, 512};        // each dataset at n^3 (resampled or generated)
+    std::vector<int> sizes = {256, 512};  // each dataset at n^3 (resampled or generated)
     std::vector<int> max_boxes = {1, 2, 4, 8, 16, 32, 0};  // 0 = every leaf
-    OrbitSpec orbit{4, 256, 20.f};              // views, image size, elevation
-    float step = 0.5f;                          // RenderOptions::step
-    float ert = 0.99f;                          // RenderOptions::ert (>= 1: off)
-    int repeats = 5;                            // preprocessing builds (medians reported)
-    int threads = 0;                            // build and render threads (0 = all)
-    AccelOptions accel;                         // kd settings (kd_max_boxes is overwritten)
-    DatasetSource source;                       // templates folder, tree seed
+    OrbitSpec orbit{4, 256, 20.f};                         // views, image size, elevation
+    float step = 0.5f;                                     // RenderOptions::step
+    float ert = 0.99f;                                     // RenderOptions::ert (>= 1: off)
+    int repeats = 5;       // preprocessing builds (medians reported)
+    int threads = 0;       // build and render threads (0 = all)
+    AccelOptions accel;    // kd settings (kd_max_boxes is overwritten)
+    DatasetSource source;  // templates folder, tree seed
 };
 
 // Per-cell classes of the TF classification: 0 empty and connected to the grid boundary through
@@ -57,16 +57,16 @@ struct KdListResult {
     int max_boxes = 0;  // M (0 = every leaf)
     int boxes = 0;      // subvolumes in the list
     uint64_t listed_cells = 0;
-    double removed_percent = 0;        // of the volume
-    double removed_empty_percent = 0;  // of the empty cells
-    double empty_in_boxes_percent = 0; // of the boxes' volume: empty cells the boxes still hold
-    double holes_kept_percent = 0;     // of the interior-hole cells: inside the boxes
-    double list_ms = 0;                // step 4
-    double build_ms = 0;               // KdTree steps 1-4 with this M (rendering structure)
+    double removed_percent = 0;         // of the volume
+    double removed_empty_percent = 0;   // of the empty cells
+    double empty_in_boxes_percent = 0;  // of the boxes' volume: empty cells the boxes still hold
+    double holes_kept_percent = 0;      // of the interior-hole cells: inside the boxes
+    double list_ms = 0;                 // step 4
+    double build_ms = 0;                // KdTree steps 1-4 with this M (rendering structure)
     Summary frame_ms;
     uint64_t samples = 0, rays = 0;
-    double speedup = 0;                // none's mean frame / this mean frame
-    bool exact = false;                // view 0 bytes == none's
+    double speedup = 0;  // none's mean frame / this mean frame
+    bool exact = false;  // view 0 bytes == none's
     double samples_per_ray() const { return rays ? double(samples) / double(rays) : 0; }
 };
 
@@ -79,15 +79,17 @@ struct KdDatasetResult {
     VoxelType type = VoxelType::UInt8;
     uint64_t cells = 0, non_empty = 0, holes = 0;
     int nodes = 0, leaves = 0, depth = 0, delta = 0;
-    double prepare_s = 0;              // load/resample/generate time
-    KdTimings median;                  // per-step medians (seconds)
-    double preprocess_median_ms = 0;   // median of the per-build totals of steps 1-3
-    std::vector<double> preprocess_ms; // every build's steps 1-3
+    double prepare_s = 0;               // load/resample/generate time
+    KdTimings median;                   // per-step medians (seconds)
+    double preprocess_median_ms = 0;    // median of the per-build totals of steps 1-3
+    std::vector<double> preprocess_ms;  // every build's steps 1-3
     size_t table_bytes = 0, tree_bytes = 0, volume_bytes = 0;
     Summary none_ms;
     uint64_t none_samples = 0, none_rays = 0;
     std::vector<KdListResult> lists;
-    double empty_percent() const { return cells ? 100.0 * double(cells - non_empty) / double(cells) : 0; }
+    double empty_percent() const {
+        return cells ? 100.0 * double(cells - non_empty) / double(cells) : 0;
+    }
 };
 
 struct KdBenchReport {

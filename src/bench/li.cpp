@@ -15,14 +15,18 @@ namespace lacuna::bench {
 
 namespace {
 
-double fps(const LiColumn* c) { return c && c->mean_ms > 0 ? 1e3 / c->mean_ms : 0; }
+double fps(const LiColumn* c) {
+    return c && c->mean_ms > 0 ? 1e3 / c->mean_ms : 0;
+}
 double ratio(const LiColumn* a, const LiColumn* b) {
     return a && b && b->mean_ms > 0 ? a->mean_ms / b->mean_ms : 0;
 }
 double cpu_ratio(const LiColumn* a, const LiColumn* b) {
     return a && b && b->cpu_ms > 0 ? a->cpu_ms / b->cpu_ms : 0;
 }
-double cpu_now_ms() { return 1e3 * double(std::clock()) / CLOCKS_PER_SEC; }
+double cpu_now_ms() {
+    return 1e3 * double(std::clock()) / CLOCKS_PER_SEC;
+}
 
 void finish(LiColumn& c) {
     c.mean_ms = mean(c.frame_ms);
@@ -82,7 +86,8 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
             d.partition_ms = 1e3 * (bs.gradient + bs.grow + bs.measure + bs.ranges);
             d.bsp_ms = 1e3 * (bs.split + bs.merge);
         }
-        if (log) log(ds.name + ": " + o.ess + " boxes built in " + fmt("%.1f", d.source_ms) + " ms");
+        if (log)
+            log(ds.name + ": " + o.ess + " boxes built in " + fmt("%.1f", d.source_ms) + " ms");
 
         // The orbit with the ESS boxes (or Basic's one box) and the occlusion settings.
         auto frames = [&](bool boxes, bool occlusion, OcclusionUse use, bool adaptive) {
@@ -114,7 +119,8 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
                 const bool boxes = !std::holds_alternative<structure::None>(fs[v].structure);
                 if (v == 0 && boxes) d.boxes = st.boxes;
                 if (v == 0 && boxes)
-                    d.box_voxels = st.voxels / (double(d.dims.x - 1) * (d.dims.y - 1) * (d.dims.z - 1));
+                    d.box_voxels =
+                        st.voxels / (double(d.dims.x - 1) * (d.dims.y - 1) * (d.dims.z - 1));
                 if (name == "ESS+CC") {
                     d.desired_updates.push_back(st.desired_updates);
                     d.actual_updates.push_back(st.map_updates);
@@ -180,8 +186,7 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
                 rep.figure6.actual.push_back(r.slicer->map_updates);
                 rep.figure6.skipped.push_back(r.slicer->skipped_fraction);
             }
-            if (log)
-                log("  Figure 6: " + std::to_string(long_orbit.size()) + " ESS+CC frames");
+            if (log) log("  Figure 6: " + std::to_string(long_orbit.size()) + " ESS+CC frames");
         }
         rep.datasets.push_back(std::move(d));
     }
@@ -190,7 +195,8 @@ LiReport run_li(const std::vector<BenchDataset>& datasets, const LiOptions& o, c
 
 std::string li_markdown(const LiReport& r, const RunInfo& info) {
     const LiOptions& o = r.options;
-    std::string out = "# lacuna bench li: Tables 1 and 2 of Li, Mueller & Kaufman (2003) on our data\n\n";
+    std::string out =
+        "# lacuna bench li: Tables 1 and 2 of Li, Mueller & Kaufman (2003) on our data\n\n";
     out += run_info_markdown(info);
     out += "- Settings: " + std::to_string(o.orbit.size) + "×" + std::to_string(o.orbit.size) +
            " pixels, " + std::to_string(o.orbit.views) + " views (azimuth 360°·i/" +
@@ -198,12 +204,15 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
            "°, perspective), slice distance " + fmt("%g", o.step) +
            " voxel, no early termination (as the paper's GPU), ESS box source `" + o.ess +
            "`, occlusion threshold " + fmt("%g", o.threshold) + ", map " +
-           std::to_string(o.map_size) + "², adaptive updates from k = " +
-           std::to_string(o.initial_updates) + " (ESS+CC, ESS+C; ESS+M uses k fixed), threads " +
+           std::to_string(o.map_size) +
+           "², adaptive updates from k = " + std::to_string(o.initial_updates) +
+           " (ESS+CC, ESS+C; ESS+M uses k fixed), threads " +
            (o.threads > 0 ? std::to_string(o.threads) : "all") + ".\n\n";
 
     out += "## Table 1: empty space skipping (frames per second)\n\n";
-    out += "| dataset | size | boxes | Basic | ESS | speedup | polygon set-up (ESS), CPU / wall | ESS == Basic |\n";
+    out +=
+        "| dataset | size | boxes | Basic | ESS | speedup | polygon set-up (ESS), CPU / wall | ESS "
+        "== Basic |\n";
     out += "|---|---|---:|---:|---:|---:|---:|---|\n";
     double sum_ess = 0;
     for (const LiDataset& d : r.datasets) {
@@ -212,17 +221,19 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
         sum_ess += s;
         out += "| " + d.name + " | " + std::to_string(d.dims.x) + "×" + std::to_string(d.dims.y) +
                "×" + std::to_string(d.dims.z) + " | " + std::to_string(d.boxes) + " | " +
-               fmt("%.2f", fps(b)) + " | " + fmt("%.2f", fps(e)) + " | " + fmt("%.2f", s) +
-               " | " + fmt("%.1f%%", 100 * (e ? e->setup_fraction : 0)) + " / " +
+               fmt("%.2f", fps(b)) + " | " + fmt("%.2f", fps(e)) + " | " + fmt("%.2f", s) + " | " +
+               fmt("%.1f%%", 100 * (e ? e->setup_fraction : 0)) + " / " +
                fmt("%.1f%%", 100 * (e ? e->setup_wall : 0)) + " | " +
                (d.ess_exact ? "yes" : "**NO**") + " |\n";
     }
     if (!r.datasets.empty())
-        out += "| average | | | | | " + fmt("%.2f", sum_ess / double(r.datasets.size())) + " | | |\n";
+        out +=
+            "| average | | | | | " + fmt("%.2f", sum_ess / double(r.datasets.size())) + " | | |\n";
 
     out += "\n## Table 2: occlusion clipping\n\n";
-    out += "| dataset | Basic | ESS | ESS+CC | ESS+M | ESS+C | culled % | clipped % | total % | "
-           "speedup ESS | CC | ESS+CC |\n";
+    out +=
+        "| dataset | Basic | ESS | ESS+CC | ESS+M | ESS+C | culled % | clipped % | total % | "
+        "speedup ESS | CC | ESS+CC |\n";
     out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     double a_cul = 0, a_clip = 0, a_ess = 0, a_cc = 0, a_both = 0;
     for (const LiDataset& d : r.datasets) {
@@ -237,8 +248,8 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
         out += "| " + d.name + " | " + fmt("%.2f", fps(b)) + " | " + fmt("%.2f", fps(e)) + " | " +
                fmt("%.2f", fps(cc)) + " | " + fmt("%.2f", fps(m)) + " | " + fmt("%.2f", fps(c)) +
                " | " + fmt("%.1f", 100 * cc->culled) + " | " + fmt("%.1f", 100 * cc->clipped) +
-               " | " + fmt("%.1f", 100 * (cc->culled + cc->clipped)) + " | " +
-               fmt("%.2f", s_ess) + " | " + fmt("%.2f", s_cc) + " | " + fmt("%.2f", s_both) + " |\n";
+               " | " + fmt("%.1f", 100 * (cc->culled + cc->clipped)) + " | " + fmt("%.2f", s_ess) +
+               " | " + fmt("%.2f", s_cc) + " | " + fmt("%.2f", s_both) + " |\n";
     }
     if (!r.datasets.empty()) {
         const double n = double(r.datasets.size());
@@ -247,16 +258,19 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
                " | " + fmt("%.2f", a_ess / n) + " | " + fmt("%.2f", a_cc / n) + " | " +
                fmt("%.2f", a_both / n) + " |\n";
     }
-    out += "\nFrames per second = 1000 / mean frame time over the orbit. Culled / clipped = share "
-           "of the non-empty voxels (cells in the ESS boxes) skipped, mean over the orbit "
-           "(ESS+CC). Speedups: ESS = Basic/ESS, CC = ESS/(ESS+CC), ESS+CC = Basic/(ESS+CC), "
-           "all from this run.\n\n";
+    out +=
+        "\nFrames per second = 1000 / mean frame time over the orbit. Culled / clipped = share "
+        "of the non-empty voxels (cells in the ESS boxes) skipped, mean over the orbit "
+        "(ESS+CC). Speedups: ESS = Basic/ESS, CC = ESS/(ESS+CC), ESS+CC = Basic/(ESS+CC), "
+        "all from this run.\n\n";
 
     out += "## CPU time per frame (all threads) and the speedups it gives\n\n";
-    out += "Wall-clock frame rates above depend on what else the machine runs; process CPU time "
-           "per frame counts only this run's work.\n\n";
-    out += "| dataset | Basic | ESS | ESS+CC | ESS+M | ESS+C | march none | speedup ESS | CC | "
-           "ESS+CC | slicer Basic / march none |\n";
+    out +=
+        "Wall-clock frame rates above depend on what else the machine runs; process CPU time "
+        "per frame counts only this run's work.\n\n";
+    out +=
+        "| dataset | Basic | ESS | ESS+CC | ESS+M | ESS+C | march none | speedup ESS | CC | "
+        "ESS+CC | slicer Basic / march none |\n";
     out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const LiDataset& d : r.datasets) {
         const LiColumn *b = d.find("Basic"), *e = d.find("ESS"), *cc = d.find("ESS+CC"),
@@ -269,9 +283,11 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
     }
     out += "\n(ms of CPU per frame.)\n\n";
     out += "## Details\n\n";
-    out += "| dataset | TF | source build [ms] (partition + BSP) | box voxels % | Basic [ms] | ESS [ms] | ESS+CC [ms] | "
-           "ESS+M [ms] | ESS+C [ms] | march none [ms] | march ESS [ms] | ESS+M == ESS | max "
-           "|ESS+CC − ESS| (8 bit) | map updates desired/actual (mean) |\n";
+    out +=
+        "| dataset | TF | source build [ms] (partition + BSP) | box voxels % | Basic [ms] | ESS "
+        "[ms] | ESS+CC [ms] | "
+        "ESS+M [ms] | ESS+C [ms] | march none [ms] | march ESS [ms] | ESS+M == ESS | max "
+        "|ESS+CC − ESS| (8 bit) | map updates desired/actual (mean) |\n";
     out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|\n";
     for (const LiDataset& d : r.datasets) {
         auto ms = [&](const char* n) {
@@ -284,13 +300,12 @@ std::string li_markdown(const LiReport& r, const RunInfo& info) {
             act += d.actual_updates[i];
         }
         const double n = double(std::max<size_t>(d.desired_updates.size(), 1));
-        const std::string parts =
-            d.partition_ms >= 0
-                ? " (" + fmt("%.1f", d.partition_ms) + " + " + fmt("%.1f", d.bsp_ms) + ")"
-                : "";
-        out += "| " + d.name + " | " + d.tf_name + " | " + fmt("%.1f", d.source_ms) + parts + " | " +
-               fmt("%.1f", 100 * d.box_voxels) + " | " + ms("Basic") + " | " + ms("ESS") + " | " +
-               ms("ESS+CC") + " | " + ms("ESS+M") + " | " + ms("ESS+C") + " | " +
+        const std::string parts = d.partition_ms >= 0 ? " (" + fmt("%.1f", d.partition_ms) + " + " +
+                                                            fmt("%.1f", d.bsp_ms) + ")"
+                                                      : "";
+        out += "| " + d.name + " | " + d.tf_name + " | " + fmt("%.1f", d.source_ms) + parts +
+               " | " + fmt("%.1f", 100 * d.box_voxels) + " | " + ms("Basic") + " | " + ms("ESS") +
+               " | " + ms("ESS+CC") + " | " + ms("ESS+M") + " | " + ms("ESS+C") + " | " +
                ms("march none") + " | " + ms(("march " + o.ess).c_str()) + " | " +
                (d.map_only_exact ? "yes" : "**NO**") + " | " + std::to_string(d.max_cc_diff) +
                " | " + fmt("%.1f", des / n) + " / " + fmt("%.1f", act / n) + " |\n";
@@ -306,8 +321,8 @@ std::string li_csv(const LiReport& r) {
     for (const LiDataset& d : r.datasets)
         for (const LiColumn& c : d.columns)
             out += d.name + "," + c.name + "," + fmt("%.3f", c.mean_ms) + "," +
-                   fmt("%.3f", c.cpu_ms) + "," + fmt("%.3f", fps(&c)) +
-                   "," + fmt("%.4f", c.setup_fraction) + "," + fmt("%.4f", c.culled) + "," +
+                   fmt("%.3f", c.cpu_ms) + "," + fmt("%.3f", fps(&c)) + "," +
+                   fmt("%.4f", c.setup_fraction) + "," + fmt("%.4f", c.culled) + "," +
                    fmt("%.4f", c.clipped) + "," + fmt("%.0f", c.samples) + "\n";
     return out;
 }

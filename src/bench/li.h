@@ -32,21 +32,21 @@ struct LiOptions {
     int map_size = 64;
     int initial_updates = 9;  // k of the adaptive window
     int threads = 0;
-    bool march = true;        // also time the ray marcher
-    int updates_views = 60;   // Figure 6: ESS+CC frames of a longer orbit on the first dataset
-                              // (0 = none)
+    bool march = true;       // also time the ray marcher
+    int updates_views = 60;  // Figure 6: ESS+CC frames of a longer orbit on the first dataset
+                             // (0 = none)
 };
 
 struct LiColumn {
-    std::string name;           // "Basic", "ESS", ...
+    std::string name;  // "Basic", "ESS", ...
     std::vector<double> frame_ms;
     double mean_ms = 0;
-    double cpu_ms = 0;          // mean process CPU time per frame (all threads; robust to a
-                                // machine shared with other jobs)
-    double setup_fraction = 0;  // mean polygon set-up share of the frame's CPU time
-    double setup_wall = 0;      // ... of its wall time (depends on thread scheduling)
+    double cpu_ms = 0;               // mean process CPU time per frame (all threads; robust to a
+                                     // machine shared with other jobs)
+    double setup_fraction = 0;       // mean polygon set-up share of the frame's CPU time
+    double setup_wall = 0;           // ... of its wall time (depends on thread scheduling)
     double culled = 0, clipped = 0;  // mean shares of non-empty voxels
-    double samples = 0;             // mean composited samples per frame
+    double samples = 0;              // mean composited samples per frame
 };
 
 struct LiDataset {
@@ -56,8 +56,8 @@ struct LiDataset {
     // Growing boxes only: the partition (gradient cells, growth, measuring the BSP pieces, the
     // per-box LUT ranges) and the BSP tree (splitting and merging), from BoxesBuildStats.
     double partition_ms = -1, bsp_ms = -1;
-    size_t boxes = 0;      // boxes of view 0
-    double box_voxels = 0; // share of the volume's cells inside the boxes
+    size_t boxes = 0;               // boxes of view 0
+    double box_voxels = 0;          // share of the volume's cells inside the boxes
     std::vector<LiColumn> columns;  // Basic, ESS, ESS+CC, ESS+M, ESS+C, march none, march ESS
     bool ess_exact = false;         // ESS view 0 == Basic view 0, byte for byte
     bool map_only_exact = false;    // ESS+M view 0 == ESS view 0

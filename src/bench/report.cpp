@@ -249,7 +249,8 @@ std::string faludi_markdown(const FaludiReport& rep, const RunInfo& info) {
     out +=
         "Build = the TF-independent part (AccelStats::build_seconds; for TF-dependent structures "
         "the last rebuild). TF change = median of " +
-        std::to_string(o.tf_repeats) + " TF changes (AccelStats::tf_update_seconds). Refine = the " +
+        std::to_string(o.tf_repeats) +
+        " TF changes (AccelStats::tf_update_seconds). Refine = the " +
         "finer per-TF level computed after the change (Accel::refine; " +
         (o.refine ? "the frames use it" : "not run: --no-refine") + ").\n\n";
     out +=
@@ -266,8 +267,8 @@ std::string faludi_markdown(const FaludiReport& rep, const RunInfo& info) {
             out += "| " + d.name + " | " + to_string(s.kind) + " | " +
                    fmt("%.1f", s.generation_ms) + " | " + fmt("%.1f", s.build_ms) + " | " +
                    fmt("%.4f", s.tf_change_ms) + " | " + ratio + " | " + fmt("%.1f", s.refine_ms) +
-                   " | " + fmt("%.2f", double(s.bytes) / (1 << 20)) + " | " + std::to_string(s.nodes) +
-                   " |\n";
+                   " | " + fmt("%.2f", double(s.bytes) / (1 << 20)) + " | " +
+                   std::to_string(s.nodes) + " |\n";
         }
     }
 
@@ -303,9 +304,8 @@ std::string faludi_csv(const FaludiReport& rep) {
                     "%s,\"%s\",%dx%dx%d,%s,%s,%s,%g,%s,%d,%d,%.4f,%.4f,%.4f,%.4f,%llu,%llu,%.4f,"
                     "%.4f,%.4f,%llu,%.4f,%.4f,%s,%.4f,%.4f,%.6f,%zu,%zu\n",
                     d.name.c_str(), d.description.c_str(), d.dims.x, d.dims.y, d.dims.z,
-                    lacuna::to_string(d.type).c_str(), d.tf_name.c_str(),
-                    csv_name(r.mode).c_str(), r.ert,
-                    to_string(c.kind).c_str(), o.orbit.size, o.orbit.views, c.frame_ms.mean,
+                    lacuna::to_string(d.type).c_str(), d.tf_name.c_str(), csv_name(r.mode).c_str(),
+                    r.ert, to_string(c.kind).c_str(), o.orbit.size, o.orbit.views, c.frame_ms.mean,
                     c.frame_ms.p99, c.frame_ms.min, c.frame_ms.max, (unsigned long long)c.samples,
                     (unsigned long long)c.rays, c.samples_per_ray(), c.speedup, c.sample_reduction,
                     (unsigned long long)r.ideal_samples, r.ideal_speedup(),

@@ -38,19 +38,19 @@ std::string operands(const A& a, const B& b) {
 
 }  // namespace lacuna::detail
 
-#define LACUNA_CHECK(cond)                                                   \
-    do {                                                                     \
+#define LACUNA_CHECK(cond)                                                      \
+    do {                                                                        \
         if (!(cond)) ::lacuna::detail::check_failed(__FILE__, __LINE__, #cond); \
     } while (false)
 
-#define LACUNA_CHECK_OP(a, op, b)                                                         \
-    do {                                                                                  \
-        const auto& lacuna_check_a_ = (a);                                                \
-        const auto& lacuna_check_b_ = (b);                                                \
-        if (!(lacuna_check_a_ op lacuna_check_b_))                                        \
-            ::lacuna::detail::check_failed(                                               \
-                __FILE__, __LINE__, #a " " #op " " #b,                                    \
-                ::lacuna::detail::operands(lacuna_check_a_, lacuna_check_b_));            \
+#define LACUNA_CHECK_OP(a, op, b)                                              \
+    do {                                                                       \
+        const auto& lacuna_check_a_ = (a);                                     \
+        const auto& lacuna_check_b_ = (b);                                     \
+        if (!(lacuna_check_a_ op lacuna_check_b_))                             \
+            ::lacuna::detail::check_failed(                                    \
+                __FILE__, __LINE__, #a " " #op " " #b,                         \
+                ::lacuna::detail::operands(lacuna_check_a_, lacuna_check_b_)); \
     } while (false)
 
 #define LACUNA_CHECK_EQ(a, b) LACUNA_CHECK_OP(a, ==, b)
@@ -62,13 +62,15 @@ std::string operands(const A& a, const B& b) {
 
 #ifdef NDEBUG
 // Not evaluated, but still compiled (so a DCHECK cannot rot): `false && (cond)`.
-#define LACUNA_DCHECK(cond) \
-    do {                    \
-        if (false && (cond)) {} \
+#define LACUNA_DCHECK(cond)    \
+    do {                       \
+        if (false && (cond)) { \
+        }                      \
     } while (false)
 #define LACUNA_DCHECK_OP(a, op, b) \
     do {                           \
-        if (false && ((a)op(b))) {} \
+        if (false && ((a)op(b))) { \
+        }                          \
     } while (false)
 #else
 #define LACUNA_DCHECK(cond) LACUNA_CHECK(cond)

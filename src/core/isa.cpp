@@ -55,23 +55,31 @@ Isa parse_isa(const std::string& name) {
 
 bool isa_supported(Isa i) {
     switch (i) {
-        case Isa::Scalar: return true;
+        case Isa::Scalar:
+            return true;
 #if LACUNA_SIMD_X86
 #if defined(__SSE4_1__)
-        case Isa::Sse41: return true;
+        case Isa::Sse41:
+            return true;
 #else
-        case Isa::Sse41: return false;
+        case Isa::Sse41:
+            return false;
 #endif
-        case Isa::Avx2: return __builtin_cpu_supports("avx2");
-        case Isa::Avx512: return __builtin_cpu_supports("avx512f");
+        case Isa::Avx2:
+            return __builtin_cpu_supports("avx2");
+        case Isa::Avx512:
+            return __builtin_cpu_supports("avx512f");
 #else
-        default: return false;
+        default:
+            return false;
 #endif
     }
     return false;
 }
 
-Isa active_isa() { return Isa(chosen().load(std::memory_order_relaxed)); }
+Isa active_isa() {
+    return Isa(chosen().load(std::memory_order_relaxed));
+}
 
 void set_isa(Isa i) {
     while (!isa_supported(i)) i = Isa(int(i) - 1);
@@ -80,10 +88,14 @@ void set_isa(Isa i) {
 
 int lanes_of(Isa i) {
     switch (i) {
-        case Isa::Scalar: return 1;
-        case Isa::Sse41: return 4;
-        case Isa::Avx2: return 8;
-        case Isa::Avx512: return 16;
+        case Isa::Scalar:
+            return 1;
+        case Isa::Sse41:
+            return 4;
+        case Isa::Avx2:
+            return 8;
+        case Isa::Avx512:
+            return 16;
     }
     return 1;
 }

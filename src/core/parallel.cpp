@@ -1,15 +1,14 @@
 #include "core/parallel.h"
 
-#include <ctime>
-
-#include "core/cancel.h"
-
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <ctime>
 #include <thread>
+
+#include "core/cancel.h"
 
 namespace lacuna {
 
@@ -23,9 +22,15 @@ namespace {
 thread_local const std::atomic<bool>* t_cancel = nullptr;  // core/cancel.h
 }  // namespace
 
-CancelScope::CancelScope(const std::atomic<bool>& flag) : m_previous(t_cancel) { t_cancel = &flag; }
-CancelScope::~CancelScope() { t_cancel = m_previous; }
-const std::atomic<bool>* current_cancel_flag() { return t_cancel; }
+CancelScope::CancelScope(const std::atomic<bool>& flag) : m_previous(t_cancel) {
+    t_cancel = &flag;
+}
+CancelScope::~CancelScope() {
+    t_cancel = m_previous;
+}
+const std::atomic<bool>* current_cancel_flag() {
+    return t_cancel;
+}
 
 void parallel_for_tiles(int width, int height, int tile, int threads,
                         const std::function<void(int, int, int, int)>& fn) {

@@ -118,7 +118,7 @@ struct CameraView {
 struct RayBatch8 {
     alignas(32) float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8], t_near[8], t_far[8];
     alignas(32) float wx[8], wy[8], wz[8];  // the world direction (Camera::generate's Ray::dir)
-    alignas(32) int32_t hit[8];  // -1: the ray meets the box [0, hi]
+    alignas(32) int32_t hit[8];             // -1: the ray meets the box [0, hi]
 };
 
 #if LACUNA_SIMD_X86
@@ -152,14 +152,14 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
     const __m128i vzero_entry = _mm_set1_epi32(g.zero_entry);
     __m128 o[3], d[3], tb, ar, ag, ab, aa;
     __m128i kend, active, k, n;
-#define LACUNA_LOAD_LANES                                                   \
+#define LACUNA_LOAD_LANES                                                         \
     o[0] = _mm_load_ps(s.ox), o[1] = _mm_load_ps(s.oy), o[2] = _mm_load_ps(s.oz); \
     d[0] = _mm_load_ps(s.dx), d[1] = _mm_load_ps(s.dy), d[2] = _mm_load_ps(s.dz); \
-    tb = _mm_load_ps(s.t_base);                                             \
-    kend = _mm_load_si128(reinterpret_cast<const __m128i*>(s.kend));        \
-    active = _mm_load_si128(reinterpret_cast<const __m128i*>(s.active));    \
-    k = _mm_load_si128(reinterpret_cast<const __m128i*>(s.k));              \
-    n = _mm_load_si128(reinterpret_cast<const __m128i*>(s.n));              \
+    tb = _mm_load_ps(s.t_base);                                                   \
+    kend = _mm_load_si128(reinterpret_cast<const __m128i*>(s.kend));              \
+    active = _mm_load_si128(reinterpret_cast<const __m128i*>(s.active));          \
+    k = _mm_load_si128(reinterpret_cast<const __m128i*>(s.k));                    \
+    n = _mm_load_si128(reinterpret_cast<const __m128i*>(s.n));                    \
     ar = _mm_load_ps(s.r), ag = _mm_load_ps(s.g), ab = _mm_load_ps(s.b), aa = _mm_load_ps(s.a);
     LACUNA_LOAD_LANES
     const ptrdiff_t sy = g.sy, sz = g.sz, syz = ptrdiff_t(g.sy) + g.sz;
@@ -177,7 +177,8 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
                 c[a] = _mm_cvttps_epi32(_mm_add_ps(x, half));
             }
             const __m128i off = _mm_and_si128(
-                _mm_add_epi32(_mm_add_epi32(_mm_mullo_epi32(c[2], vsz), _mm_mullo_epi32(c[1], vsy)), c[0]),
+                _mm_add_epi32(_mm_add_epi32(_mm_mullo_epi32(c[2], vsz), _mm_mullo_epi32(c[1], vsy)),
+                              c[0]),
                 active);
             alignas(16) int32_t ofs[4];
             alignas(16) float vals[4];
@@ -208,20 +209,25 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
                     __builtin_memcpy(&w, p, 2);
                     return int(w);
                 };
-    #define LACUNA_PAIRS(l)                                        \
-        {                                                          \
-            const T* p = data + ofs[l];                            \
-            v01 = _mm_insert_epi16(v01, pair(p), l);               \
-            v01 = _mm_insert_epi16(v01, pair(p + sy), 4 + l);      \
-            v23 = _mm_insert_epi16(v23, pair(p + sz), l);          \
-            v23 = _mm_insert_epi16(v23, pair(p + syz), 4 + l);     \
-        }
-                LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
-    #undef LACUNA_PAIRS
-                const __m128i m_lo0 = _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
-                const __m128i m_hi0 = _mm_setr_epi8(1, -1, -1, -1, 3, -1, -1, -1, 5, -1, -1, -1, 7, -1, -1, -1);
-                const __m128i m_lo1 = _mm_setr_epi8(8, -1, -1, -1, 10, -1, -1, -1, 12, -1, -1, -1, 14, -1, -1, -1);
-                const __m128i m_hi1 = _mm_setr_epi8(9, -1, -1, -1, 11, -1, -1, -1, 13, -1, -1, -1, 15, -1, -1, -1);
+#define LACUNA_PAIRS(l)                                    \
+    {                                                      \
+        const T* p = data + ofs[l];                        \
+        v01 = _mm_insert_epi16(v01, pair(p), l);           \
+        v01 = _mm_insert_epi16(v01, pair(p + sy), 4 + l);  \
+        v23 = _mm_insert_epi16(v23, pair(p + sz), l);      \
+        v23 = _mm_insert_epi16(v23, pair(p + syz), 4 + l); \
+    }
+                LACUNA_PAIRS(0)
+                LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+#undef LACUNA_PAIRS
+                    const __m128i m_lo0 =
+                        _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
+                const __m128i m_hi0 =
+                    _mm_setr_epi8(1, -1, -1, -1, 3, -1, -1, -1, 5, -1, -1, -1, 7, -1, -1, -1);
+                const __m128i m_lo1 =
+                    _mm_setr_epi8(8, -1, -1, -1, 10, -1, -1, -1, 12, -1, -1, -1, 14, -1, -1, -1);
+                const __m128i m_hi1 =
+                    _mm_setr_epi8(9, -1, -1, -1, 11, -1, -1, -1, 13, -1, -1, -1, 15, -1, -1, -1);
                 lo[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo0));
                 hi[0] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_hi0));
                 lo[1] = _mm_cvtepi32_ps(_mm_shuffle_epi8(v01, m_lo1));
@@ -238,17 +244,18 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
                     __builtin_memcpy(&w, p, 4);
                     return w;
                 };
-    #define LACUNA_PAIRS(l)                                  \
-        {                                                    \
-            const T* p = data + ofs[l];                      \
-            v[0] = _mm_insert_epi32(v[0], pair(p), l);       \
-            v[1] = _mm_insert_epi32(v[1], pair(p + sy), l);  \
-            v[2] = _mm_insert_epi32(v[2], pair(p + sz), l);  \
-            v[3] = _mm_insert_epi32(v[3], pair(p + syz), l); \
-        }
-                LACUNA_PAIRS(0) LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
-    #undef LACUNA_PAIRS
-                for (int q = 0; q < 4; ++q) {
+#define LACUNA_PAIRS(l)                                  \
+    {                                                    \
+        const T* p = data + ofs[l];                      \
+        v[0] = _mm_insert_epi32(v[0], pair(p), l);       \
+        v[1] = _mm_insert_epi32(v[1], pair(p + sy), l);  \
+        v[2] = _mm_insert_epi32(v[2], pair(p + sz), l);  \
+        v[3] = _mm_insert_epi32(v[3], pair(p + syz), l); \
+    }
+                LACUNA_PAIRS(0)
+                LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+#undef LACUNA_PAIRS
+                    for (int q = 0; q < 4; ++q) {
                     if constexpr (std::is_signed_v<T>) {
                         lo[q] = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(v[q], 16), 16));
                         hi[q] = _mm_cvtepi32_ps(_mm_srai_epi32(v[q], 16));
@@ -285,8 +292,10 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
         // 4. Composite one sample per lane: RGBA of the 4 entries, transposed to SoA.
         alignas(16) int32_t e[4];
         _mm_store_si128(reinterpret_cast<__m128i*>(e), entry);
-        __m128 cr = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[0])), cg = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[1]));
-        __m128 cb = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[2])), ca = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[3]));
+        __m128 cr = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[0])),
+               cg = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[1]));
+        __m128 cb = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[2])),
+               ca = _mm_loadu_ps(lut + 4 * ptrdiff_t(e[3]));
         _MM_TRANSPOSE4_PS(cr, cg, cb, ca);
         const __m128 w = _mm_sub_ps(one, aa);
         ar = _mm_add_ps(ar, _mm_mul_ps(w, cr));
@@ -296,8 +305,8 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
         n = _mm_sub_epi32(n, valid);
         k = _mm_sub_epi32(k, valid);  // k + 1 on valid lanes
         // 5. A lane needs the scheduler when its run is over or it is opaque.
-        const __m128i over = _mm_or_si128(_mm_cmpeq_epi32(k, kend),
-                                          _mm_castps_si128(_mm_cmpge_ps(aa, vert)));
+        const __m128i over =
+            _mm_or_si128(_mm_cmpeq_epi32(k, kend), _mm_castps_si128(_mm_cmpge_ps(aa, vert)));
         need = _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(over, active)));
         if (need) {
             _mm_store_si128(reinterpret_cast<__m128i*>(s.k), k);
@@ -322,9 +331,8 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
 // does), trilinear()'s operations in its order. G has hi[3], cell[3], sy, sz. Corners: uint8
 // pairs by 16-bit scalar loads (cheaper than gathers here), wider types by 32-bit gathers.
 template <class T, class G>
-LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
-                                                                    const T* data, __m256 x,
-                                                                    __m256 y, __m256 z) {
+LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g, const T* data,
+                                                                    __m256 x, __m256 y, __m256 z) {
     const __m256 zero = _mm256_setzero_ps();
     x = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), x));
     y = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), y));
@@ -335,14 +343,15 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
     const __m256 fx = _mm256_sub_ps(x, _mm256_cvtepi32_ps(ci));
     const __m256 fy = _mm256_sub_ps(y, _mm256_cvtepi32_ps(cj));
     const __m256 fz = _mm256_sub_ps(z, _mm256_cvtepi32_ps(ck));
-    const __m256i off = _mm256_add_epi32(
-        _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
-                         _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
-        ci);
+    const __m256i off =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                                          _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+                         ci);
     constexpr bool kByte = sizeof(T) == 1;
     const __m256i o1 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy - 2 : g.sy));
     const __m256i o2 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sz - 2 : g.sz));
-    const __m256i o3 = _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz));
+    const __m256i o3 =
+        _mm256_add_epi32(off, _mm256_set1_epi32(kByte ? g.sy + g.sz - 2 : g.sy + g.sz));
     __m256 c000, c100, c010, c110, c001, c101, c011, c111;
     if constexpr (kByte) {
         // Corner pairs by 16-bit scalar loads into a small table (cheaper than four gathers
@@ -359,10 +368,14 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
             __builtin_memcpy(&w[3][l], p + syz, 2);
         }
         const __m256i m = _mm256_set1_epi32(0xff);
-        const __m256i w0 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[0])));
-        const __m256i w1 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[1])));
-        const __m256i w2 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[2])));
-        const __m256i w3 = _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[3])));
+        const __m256i w0 =
+            _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[0])));
+        const __m256i w1 =
+            _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[1])));
+        const __m256i w2 =
+            _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[2])));
+        const __m256i w3 =
+            _mm256_cvtepu16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(w[3])));
         c000 = _mm256_cvtepi32_ps(_mm256_and_si256(w0, m));
         c100 = _mm256_cvtepi32_ps(_mm256_srli_epi32(w0, 8));
         c010 = _mm256_cvtepi32_ps(_mm256_and_si256(w1, m));
@@ -434,7 +447,7 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 trilinear8(const G& g,
 // loads into a table.
 template <class T, class G>
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, const T* data,
-                                                                   __m256 x, __m256 y, __m256 z) {
+                                                                  __m256 x, __m256 y, __m256 z) {
     const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
     x = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), x));
     y = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), y));
@@ -442,10 +455,10 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 nearest8(const G& g, co
     const __m256i ci = _mm256_cvttps_epi32(_mm256_add_ps(x, half));
     const __m256i cj = _mm256_cvttps_epi32(_mm256_add_ps(y, half));
     const __m256i ck = _mm256_cvttps_epi32(_mm256_add_ps(z, half));
-    const __m256i off = _mm256_add_epi32(
-        _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
-                         _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
-        ci);
+    const __m256i off =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                                          _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+                         ci);
     if constexpr (std::is_same_v<T, float>) {
         return _mm256_i32gather_ps(data, off, 4);
     } else {
@@ -463,8 +476,9 @@ struct LeapInverse {
     alignas(64) float inv[3][kMaxLanes];
     alignas(64) int32_t octant[kMaxLanes];
 };
-LACUNA_AVX2 inline __attribute__((always_inline)) void leap_inverse8(__m256 dx, __m256 dy, __m256 dz,
-                                                                  int32_t stride, LeapInverse& li) {
+LACUNA_AVX2 inline __attribute__((always_inline)) void leap_inverse8(__m256 dx, __m256 dy,
+                                                                     __m256 dz, int32_t stride,
+                                                                     LeapInverse& li) {
     const __m256 big = _mm256_set1_ps(1e30f), one = _mm256_set1_ps(1.f);
     const __m256 d[3] = {dx, dy, dz};
     __m256i oct = _mm256_setzero_si256();
@@ -472,7 +486,8 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap_inverse8(__m256 dx, 
         const __m256 inv = _mm256_max_ps(_mm256_sub_ps(_mm256_setzero_ps(), big),
                                          _mm256_min_ps(big, _mm256_div_ps(one, d[a])));
         _mm256_store_ps(li.inv[a], inv);
-        oct = _mm256_or_si256(oct, _mm256_slli_epi32(_mm256_srli_epi32(_mm256_castps_si256(inv), 31), a));
+        oct = _mm256_or_si256(
+            oct, _mm256_slli_epi32(_mm256_srli_epi32(_mm256_castps_si256(inv), 31), a));
     }
     _mm256_store_si256(reinterpret_cast<__m256i*>(li.octant),
                        _mm256_mullo_epi32(oct, _mm256_set1_epi32(stride)));
@@ -480,7 +495,7 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap_inverse8(__m256 dx, 
 // The valid lanes' next sample: k + 1, or leaping k + adv (at most kend).
 template <bool kLeap>
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256i advance8(__m256i k, __m256i kend,
-                                                                __m256i valid, __m256i adv) {
+                                                                   __m256i valid, __m256i adv) {
     if constexpr (kLeap)
         return _mm256_min_epi32(_mm256_add_epi32(k, _mm256_and_si256(adv, valid)), kend);
     else
@@ -490,9 +505,9 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256i advance8(__m256i k, __
 // Leaping, eight lanes (see "Leaping" above): for the valid lanes whose sample (x, y, z, not
 // yet clamped) lies in an empty fine brick, taken loses the lane and adv becomes its skip.
 LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, __m256 x, __m256 y,
-                                                        __m256 z, __m256i valid, __m256 inv_dt,
-                                                        const LeapInverse& li, __m256i& taken,
-                                                        __m256i& adv) {
+                                                             __m256 z, __m256i valid, __m256 inv_dt,
+                                                             const LeapInverse& li, __m256i& taken,
+                                                             __m256i& adv) {
     const __m256 zero = _mm256_setzero_ps();
     const __m256 p[3] = {x, y, z};
     __m256 q[3];
@@ -506,25 +521,30 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, 
         _mm256_add_epi32(_mm256_mullo_epi32(f[2], _mm256_set1_epi32(g.leap_sz)),
                          _mm256_mullo_epi32(f[1], _mm256_set1_epi32(g.leap_sy))),
         _mm256_add_epi32(f[0], _mm256_load_si256(reinterpret_cast<const __m256i*>(li.octant))));
-    const __m256i w = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
-                                                  reinterpret_cast<const int*>(g.leap), idx, valid, 2);
+    const __m256i w = _mm256_mask_i32gather_epi32(
+        _mm256_setzero_si256(), reinterpret_cast<const int*>(g.leap), idx, valid, 2);
     const __m256i d = _mm256_and_si256(w, _mm256_set1_epi32(0xff));
     const __m256i one_i = _mm256_set1_epi32(1), zero_i = _mm256_setzero_si256();
     // d = 0: the bit of c's sub-brick, (c_x & 2) / 2 + (c_y & 2) + (c_z & 2) * 2.
     const __m256i two = _mm256_set1_epi32(2);
-    const __m256i sub = _mm256_add_epi32(
-        _mm256_add_epi32(_mm256_srli_epi32(_mm256_and_si256(c[0], two), 1), _mm256_and_si256(c[1], two)),
-        _mm256_slli_epi32(_mm256_and_si256(c[2], two), 1));
+    const __m256i sub =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_srli_epi32(_mm256_and_si256(c[0], two), 1),
+                                          _mm256_and_si256(c[1], two)),
+                         _mm256_slli_epi32(_mm256_and_si256(c[2], two), 1));
     const __m256i sub_vis = _mm256_and_si256(
-        _mm256_srlv_epi32(_mm256_srli_epi32(_mm256_and_si256(w, _mm256_set1_epi32(0xff00)), 8), sub), one_i);
+        _mm256_srlv_epi32(_mm256_srli_epi32(_mm256_and_si256(w, _mm256_set1_epi32(0xff00)), 8),
+                          sub),
+        one_i);
     const __m256i coarse = _mm256_xor_si256(_mm256_cmpeq_epi32(d, zero_i), _mm256_set1_epi32(-1));
-    const __m256i skip = _mm256_and_si256(_mm256_or_si256(coarse, _mm256_cmpeq_epi32(sub_vis, zero_i)), valid);
+    const __m256i skip =
+        _mm256_and_si256(_mm256_or_si256(coarse, _mm256_cmpeq_epi32(sub_vis, zero_i)), valid);
     taken = _mm256_andnot_si256(skip, valid);
     // The exit of the box: bricks within d - 1 (edge 4), or the sub-brick (edge 2, D = 1):
     // face_a = (c_a & -edge) + (dir_a < 0 ? (1 - D) edge : D edge), min_a (face_a - q_a) / dir_a.
     const __m256i D = _mm256_blendv_epi8(one_i, d, coarse);
     const __m256i sh = _mm256_blendv_epi8(one_i, two, coarse);
-    const __m256i fwd = _mm256_sllv_epi32(D, sh), back = _mm256_sllv_epi32(_mm256_sub_epi32(one_i, D), sh);
+    const __m256i fwd = _mm256_sllv_epi32(D, sh),
+                  back = _mm256_sllv_epi32(_mm256_sub_epi32(one_i, D), sh);
     const __m256i lo = _mm256_blendv_epi8(_mm256_set1_epi32(~1), _mm256_set1_epi32(~3), coarse);
     __m256 exit_t = _mm256_set1_ps(16777216.f);
     for (int a = 0; a < 3; ++a) {
@@ -535,8 +555,10 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, 
         exit_t = _mm256_min_ps(exit_t, _mm256_mul_ps(_mm256_sub_ps(face, q[a]), inv));
     }
     // (capped at 2^24 samples, far past any ray's end: cvtt stays in range; T >= 0 up to -0)
-    const __m256i leap = _mm256_add_epi32(
-        _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(exit_t, inv_dt), _mm256_set1_ps(16777216.f))), one_i);
+    const __m256i leap =
+        _mm256_add_epi32(_mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(exit_t, inv_dt),
+                                                           _mm256_set1_ps(16777216.f))),
+                         one_i);
     adv = _mm256_blendv_epi8(one_i, leap, skip);
 }
 
@@ -556,18 +578,24 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void prefetch_ahead8(
     __m256 dy, __m256 dz, __m256i lanes) {
     const __m256 zero = _mm256_setzero_ps();
     const __m256 ta = _mm256_add_ps(t, _mm256_set1_ps(float(kPrefetchSteps) * g.dt));
-    const __m256 x = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), _mm256_add_ps(ox, _mm256_mul_ps(ta, dx))));
-    const __m256 y = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), _mm256_add_ps(oy, _mm256_mul_ps(ta, dy))));
-    const __m256 z = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), _mm256_add_ps(oz, _mm256_mul_ps(ta, dz))));
+    const __m256 x = _mm256_max_ps(
+        zero, _mm256_min_ps(_mm256_set1_ps(g.hi[0]), _mm256_add_ps(ox, _mm256_mul_ps(ta, dx))));
+    const __m256 y = _mm256_max_ps(
+        zero, _mm256_min_ps(_mm256_set1_ps(g.hi[1]), _mm256_add_ps(oy, _mm256_mul_ps(ta, dy))));
+    const __m256 z = _mm256_max_ps(
+        zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), _mm256_add_ps(oz, _mm256_mul_ps(ta, dz))));
     const __m256i off = _mm256_and_si256(
-        lanes, _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(z), _mm256_set1_epi32(g.sz)),
-                                                 _mm256_mullo_epi32(_mm256_cvttps_epi32(y), _mm256_set1_epi32(g.sy))),
-                                _mm256_cvttps_epi32(x)));
+        lanes,
+        _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(z), _mm256_set1_epi32(g.sz)),
+                             _mm256_mullo_epi32(_mm256_cvttps_epi32(y), _mm256_set1_epi32(g.sy))),
+            _mm256_cvttps_epi32(x)));
     alignas(32) int32_t o[8];
     _mm256_store_si256(reinterpret_cast<__m256i*>(o), off);
     // (addresses as integers: the diagonal row of the last cell lies past the volume's end,
     // which a prefetch may name but pointer arithmetic may not)
-    const uintptr_t base = reinterpret_cast<uintptr_t>(data), diag = (uintptr_t(g.sy) + g.sz) * sizeof(T);
+    const uintptr_t base = reinterpret_cast<uintptr_t>(data),
+                    diag = (uintptr_t(g.sy) + g.sz) * sizeof(T);
     for (int l = 0; l < 8; ++l) {
         const uintptr_t a = base + uintptr_t(o[l]) * sizeof(T);
         __builtin_prefetch(reinterpret_cast<const void*>(a), 0, 3);
@@ -586,17 +614,17 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
     const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
     __m256 ox, oy, oz, dx, dy, dz, tb, ar, ag, ab, aa;
     __m256i kend, active, k, n;
-#define LACUNA_LOAD_LANES                                                             \
-    ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz);  \
-    dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz);  \
-    tb = _mm256_load_ps(s.t_base);                                                    \
-    kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));               \
-    active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));           \
-    k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));                     \
-    n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
-    ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);     \
-    aa = _mm256_load_ps(s.a);                                                         \
-    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
+#define LACUNA_LOAD_LANES                                                            \
+    ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz); \
+    dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz); \
+    tb = _mm256_load_ps(s.t_base);                                                   \
+    kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));              \
+    active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));          \
+    k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));                    \
+    n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                    \
+    ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);    \
+    aa = _mm256_load_ps(s.a);                                                        \
+    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                   \
     if constexpr (kLeap) leap_inverse8(dx, dy, dz, g.leap_octant, linv);
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
@@ -629,14 +657,19 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
         _mm256_store_si256(reinterpret_cast<__m256i*>(e), entry);
         __m256 q4[4];
         for (int i = 0; i < 4; ++i)
-            q4[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lut + 4 * ptrdiff_t(e[i]))),
-                                        _mm_loadu_ps(lut + 4 * ptrdiff_t(e[4 + i])), 1);
+            q4[i] = _mm256_insertf128_ps(
+                _mm256_castps128_ps256(_mm_loadu_ps(lut + 4 * ptrdiff_t(e[i]))),
+                _mm_loadu_ps(lut + 4 * ptrdiff_t(e[4 + i])), 1);
         const __m256 t0 = _mm256_unpacklo_ps(q4[0], q4[1]), t1 = _mm256_unpackhi_ps(q4[0], q4[1]);
         const __m256 t2 = _mm256_unpacklo_ps(q4[2], q4[3]), t3 = _mm256_unpackhi_ps(q4[2], q4[3]);
-        const __m256 cr = _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(t0), _mm256_castps_pd(t2)));
-        const __m256 cg = _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(t0), _mm256_castps_pd(t2)));
-        const __m256 cb = _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(t1), _mm256_castps_pd(t3)));
-        const __m256 ca = _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(t1), _mm256_castps_pd(t3)));
+        const __m256 cr =
+            _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(t0), _mm256_castps_pd(t2)));
+        const __m256 cg =
+            _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(t0), _mm256_castps_pd(t2)));
+        const __m256 cb =
+            _mm256_castpd_ps(_mm256_unpacklo_pd(_mm256_castps_pd(t1), _mm256_castps_pd(t3)));
+        const __m256 ca =
+            _mm256_castpd_ps(_mm256_unpackhi_pd(_mm256_castps_pd(t1), _mm256_castps_pd(t3)));
         const __m256 w = _mm256_sub_ps(one, aa);
         ar = _mm256_add_ps(ar, _mm256_mul_ps(w, cr));
         ag = _mm256_add_ps(ag, _mm256_mul_ps(w, cg));
@@ -680,17 +713,19 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
 // pair (i, i + 1) at (j + (r & 1), k + (r >> 1)); a Word is two voxels (uint16_t for bytes,
 // int32_t for 16-bit voxels). kSparse: only the `live` lanes load, the others read 0.
 template <class Word, class T>
-LACUNA_AVX512 inline __attribute__((always_inline)) void load_pair_rows(const T* p, int l, ptrdiff_t psy,
-                                                                   ptrdiff_t psz, Word (*w)[16]) {
+LACUNA_AVX512 inline __attribute__((always_inline)) void load_pair_rows(const T* p, int l,
+                                                                        ptrdiff_t psy,
+                                                                        ptrdiff_t psz,
+                                                                        Word (*w)[16]) {
     __builtin_memcpy(&w[0][l], p, sizeof(Word));
     __builtin_memcpy(&w[1][l], p + psy, sizeof(Word));
     __builtin_memcpy(&w[2][l], p + psz, sizeof(Word));
     __builtin_memcpy(&w[3][l], p + psy + psz, sizeof(Word));
 }
 template <bool kSparse, class Word, class T>
-LACUNA_AVX512 inline __attribute__((always_inline)) void corner_pairs16(const T* data, const int32_t* ofs,
-                                                                   __mmask16 live, ptrdiff_t psy,
-                                                                   ptrdiff_t psz, Word (*w)[16]) {
+LACUNA_AVX512 inline __attribute__((always_inline)) void corner_pairs16(
+    const T* data, const int32_t* ofs, __mmask16 live, ptrdiff_t psy, ptrdiff_t psz,
+    Word (*w)[16]) {
     if constexpr (kSparse) {
         for (size_t b = 0; b < sizeof(Word) * 4 * 16; b += 64)
             _mm512_store_si512(reinterpret_cast<char*>(w) + b, _mm512_setzero_si512());
@@ -708,8 +743,8 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void corner_pairs16(const T*
 // on most steps and a step's loads would otherwise cost as much as sixteen samples.
 template <class T, class G, bool kSparse = false>
 LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& g, const T* data,
-                                                                      __m512 x, __m512 y, __m512 z,
-                                                                      __mmask16 live) {
+                                                                       __m512 x, __m512 y, __m512 z,
+                                                                       __mmask16 live) {
     constexpr bool kByte = sizeof(T) == 1;
     const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(x), _mm512_set1_epi32(g.cell[0]));
     const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(y), _mm512_set1_epi32(g.cell[1]));
@@ -717,8 +752,10 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
     const __m512 fx = _mm512_sub_ps(x, _mm512_cvtepi32_ps(ci));
     const __m512 fy = _mm512_sub_ps(y, _mm512_cvtepi32_ps(cj));
     const __m512 fz = _mm512_sub_ps(z, _mm512_cvtepi32_ps(ck));
-    __m512i off = _mm512_add_epi32(
-        _mm512_add_epi32(_mm512_mullo_epi32(ck, _mm512_set1_epi32(g.sz)), _mm512_mullo_epi32(cj, _mm512_set1_epi32(g.sy))), ci);
+    __m512i off =
+        _mm512_add_epi32(_mm512_add_epi32(_mm512_mullo_epi32(ck, _mm512_set1_epi32(g.sz)),
+                                          _mm512_mullo_epi32(cj, _mm512_set1_epi32(g.sy))),
+                         ci);
     off = _mm512_maskz_mov_epi32(live, off);  // other lanes read voxel 0
     __m512 c000, c100, c010, c110, c001, c101, c011, c111;
     if constexpr (kByte) {
@@ -729,10 +766,14 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
         _mm512_store_si512(ofs, off);
         corner_pairs16<kSparse>(data, ofs, live, g.sy, g.sz, wp);
         const __m512i m = _mm512_set1_epi32(0xff);
-        const __m512i w0 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
-        const __m512i w1 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
-        const __m512i w2 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[2])));
-        const __m512i w3 = _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[3])));
+        const __m512i w0 =
+            _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[0])));
+        const __m512i w1 =
+            _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[1])));
+        const __m512i w2 =
+            _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[2])));
+        const __m512i w3 =
+            _mm512_cvtepu16_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(wp[3])));
         c000 = _mm512_cvtepi32_ps(_mm512_and_si512(w0, m));
         c100 = _mm512_cvtepi32_ps(_mm512_srli_epi32(w0, 8));
         c010 = _mm512_cvtepi32_ps(_mm512_and_si512(w1, m));
@@ -793,10 +834,9 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
 }
 
 // Leaping, sixteen lanes: leap8's operations on positions already clamped into [0, hi].
-LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& g, __m512 x, __m512 y,
-                                                           __m512 z, __mmask16 valid, __m512 inv_dt,
-                                                           const LeapInverse& li, __mmask16& taken,
-                                                           __m512i& adv, int b = 0) {
+LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(
+    const LaneGrid& g, __m512 x, __m512 y, __m512 z, __mmask16 valid, __m512 inv_dt,
+    const LeapInverse& li, __mmask16& taken, __m512i& adv, int b = 0) {
     const __m512 zero = _mm512_setzero_ps();
     const __m512i ione = _mm512_set1_epi32(1);
     const __m512 q[3] = {x, y, z};
@@ -804,15 +844,17 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
     for (int a = 0; a < 3; ++a)
         c[a] = _mm512_min_epi32(_mm512_cvttps_epi32(q[a]), _mm512_set1_epi32(g.cell[a]));
     const __m512i idx = _mm512_add_epi32(
-        _mm512_add_epi32(_mm512_mullo_epi32(_mm512_srli_epi32(c[2], 2), _mm512_set1_epi32(g.leap_sz)),
-                         _mm512_mullo_epi32(_mm512_srli_epi32(c[1], 2), _mm512_set1_epi32(g.leap_sy))),
+        _mm512_add_epi32(
+            _mm512_mullo_epi32(_mm512_srli_epi32(c[2], 2), _mm512_set1_epi32(g.leap_sz)),
+            _mm512_mullo_epi32(_mm512_srli_epi32(c[1], 2), _mm512_set1_epi32(g.leap_sy))),
         _mm512_add_epi32(_mm512_srli_epi32(c[0], 2), _mm512_load_si512(li.octant + b)));
     const __m512i w = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), valid, idx, g.leap, 2);
     const __m512i d = _mm512_and_si512(w, _mm512_set1_epi32(0xff));
     const __m512i two = _mm512_set1_epi32(2);
-    const __m512i sub = _mm512_add_epi32(
-        _mm512_add_epi32(_mm512_srli_epi32(_mm512_and_si512(c[0], two), 1), _mm512_and_si512(c[1], two)),
-        _mm512_slli_epi32(_mm512_and_si512(c[2], two), 1));
+    const __m512i sub =
+        _mm512_add_epi32(_mm512_add_epi32(_mm512_srli_epi32(_mm512_and_si512(c[0], two), 1),
+                                          _mm512_and_si512(c[1], two)),
+                         _mm512_slli_epi32(_mm512_and_si512(c[2], two), 1));
     const __m512i sub_bits = _mm512_srli_epi32(_mm512_and_si512(w, _mm512_set1_epi32(0xff00)), 8);
     const __mmask16 coarse = _mm512_test_epi32_mask(d, d);
     const __mmask16 sub_vis = _mm512_test_epi32_mask(_mm512_srlv_epi32(sub_bits, sub), ione);
@@ -821,31 +863,39 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(const LaneGrid& 
     // The exit of the box (leap8's form): bricks within d - 1, or the sub-brick.
     const __m512i D = _mm512_mask_blend_epi32(coarse, ione, d);
     const __m512i sh = _mm512_mask_blend_epi32(coarse, ione, two);
-    const __m512i fwd = _mm512_sllv_epi32(D, sh), back = _mm512_sllv_epi32(_mm512_sub_epi32(ione, D), sh);
-    const __m512i lo = _mm512_mask_blend_epi32(coarse, _mm512_set1_epi32(~1), _mm512_set1_epi32(~3));
+    const __m512i fwd = _mm512_sllv_epi32(D, sh),
+                  back = _mm512_sllv_epi32(_mm512_sub_epi32(ione, D), sh);
+    const __m512i lo =
+        _mm512_mask_blend_epi32(coarse, _mm512_set1_epi32(~1), _mm512_set1_epi32(~3));
     __m512 exit_t = _mm512_set1_ps(16777216.f);
     for (int a = 0; a < 3; ++a) {
         const __m512 inv = _mm512_load_ps(li.inv[a] + b);
-        const __m512i ahead = _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), fwd, back);
+        const __m512i ahead =
+            _mm512_mask_blend_epi32(_mm512_cmp_ps_mask(inv, zero, _CMP_LT_OQ), fwd, back);
         const __m512 face = _mm512_cvtepi32_ps(_mm512_add_epi32(_mm512_and_si512(c[a], lo), ahead));
         exit_t = _mm512_min_ps(exit_t, _mm512_mul_ps(_mm512_sub_ps(face, q[a]), inv));
     }
     // (capped at 2^24 samples, far past any ray's end: cvtt stays in range)
-    const __m512i leap = _mm512_add_epi32(
-        _mm512_cvttps_epi32(_mm512_min_ps(_mm512_mul_ps(exit_t, inv_dt), _mm512_set1_ps(16777216.f))), ione);
+    const __m512i leap =
+        _mm512_add_epi32(_mm512_cvttps_epi32(_mm512_min_ps(_mm512_mul_ps(exit_t, inv_dt),
+                                                           _mm512_set1_ps(16777216.f))),
+                         ione);
     adv = _mm512_mask_blend_epi32(skip, ione, leap);
 }
 // leap_inverse8's clamped 1 / dir, sixteen lanes.
-LACUNA_AVX512 inline __attribute__((always_inline)) void leap_inverse16(__m512 dx, __m512 dy, __m512 dz,
-                                                                   int32_t stride, LeapInverse& li,
-                                                                   int b = 0) {
-    const __m512 big = _mm512_set1_ps(1e30f), nbig = _mm512_set1_ps(-1e30f), one = _mm512_set1_ps(1.f);
+LACUNA_AVX512 inline __attribute__((always_inline)) void leap_inverse16(__m512 dx, __m512 dy,
+                                                                        __m512 dz, int32_t stride,
+                                                                        LeapInverse& li,
+                                                                        int b = 0) {
+    const __m512 big = _mm512_set1_ps(1e30f), nbig = _mm512_set1_ps(-1e30f),
+                 one = _mm512_set1_ps(1.f);
     const __m512 d[3] = {dx, dy, dz};
     __m512i oct = _mm512_setzero_si512();
     for (int a = 0; a < 3; ++a) {
         const __m512 inv = _mm512_max_ps(nbig, _mm512_min_ps(big, _mm512_div_ps(one, d[a])));
         _mm512_store_ps(li.inv[a] + b, inv);
-        oct = _mm512_or_si512(oct, _mm512_slli_epi32(_mm512_srli_epi32(_mm512_castps_si512(inv), 31), unsigned(a)));
+        oct = _mm512_or_si512(
+            oct, _mm512_slli_epi32(_mm512_srli_epi32(_mm512_castps_si512(inv), 31), unsigned(a)));
     }
     _mm512_store_si512(li.octant + b, _mm512_mullo_epi32(oct, _mm512_set1_epi32(stride)));
 }
@@ -857,18 +907,24 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void prefetch_ahead16(
     __m512 dy, __m512 dz, __mmask16 active) {
     const __m512 zero = _mm512_setzero_ps();
     const __m512 ta = _mm512_add_ps(t, _mm512_set1_ps(float(kPrefetchSteps) * g.dt));
-    const __m512 x = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), _mm512_add_ps(ox, _mm512_mul_ps(ta, dx))));
-    const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), _mm512_add_ps(oy, _mm512_mul_ps(ta, dy))));
-    const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), _mm512_add_ps(oz, _mm512_mul_ps(ta, dz))));
+    const __m512 x = _mm512_max_ps(
+        zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), _mm512_add_ps(ox, _mm512_mul_ps(ta, dx))));
+    const __m512 y = _mm512_max_ps(
+        zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), _mm512_add_ps(oy, _mm512_mul_ps(ta, dy))));
+    const __m512 z = _mm512_max_ps(
+        zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), _mm512_add_ps(oz, _mm512_mul_ps(ta, dz))));
     const __m512i off = _mm512_maskz_mov_epi32(
-        active, _mm512_add_epi32(_mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(z), _mm512_set1_epi32(g.sz)),
-                                                  _mm512_mullo_epi32(_mm512_cvttps_epi32(y), _mm512_set1_epi32(g.sy))),
-                                 _mm512_cvttps_epi32(x)));
+        active,
+        _mm512_add_epi32(
+            _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(z), _mm512_set1_epi32(g.sz)),
+                             _mm512_mullo_epi32(_mm512_cvttps_epi32(y), _mm512_set1_epi32(g.sy))),
+            _mm512_cvttps_epi32(x)));
     alignas(64) int32_t o[16];
     _mm512_store_si512(o, off);
     // (addresses as integers: the diagonal row of the last cell lies past the volume's end,
     // which a prefetch may name but pointer arithmetic may not)
-    const uintptr_t base = reinterpret_cast<uintptr_t>(data), diag = (uintptr_t(g.sy) + g.sz) * sizeof(T);
+    const uintptr_t base = reinterpret_cast<uintptr_t>(data),
+                    diag = (uintptr_t(g.sy) + g.sz) * sizeof(T);
     for (int l = 0; l < 16; ++l) {
         const uintptr_t a = base + uintptr_t(o[l]) * sizeof(T);
         __builtin_prefetch(reinterpret_cast<const void*>(a), 0, 3);
@@ -894,7 +950,8 @@ struct Group16 {
     __mmask16 active;
 
     LACUNA_AVX512 inline __attribute__((always_inline)) void load(const Lanes& s, int b,
-                                                                  const LaneGrid& g, LeapInverse& li) {
+                                                                  const LaneGrid& g,
+                                                                  LeapInverse& li) {
         ox = _mm512_load_ps(s.ox + b), oy = _mm512_load_ps(s.oy + b), oz = _mm512_load_ps(s.oz + b);
         dx = _mm512_load_ps(s.dx + b), dy = _mm512_load_ps(s.dy + b), dz = _mm512_load_ps(s.dz + b);
         tb = _mm512_load_ps(s.t_base + b);
@@ -916,14 +973,14 @@ struct Group16 {
         _mm512_store_ps(s.a + b, aa);
     }
     // One sample (or one leap) per valid lane; returns the active lanes whose run is over.
-    LACUNA_AVX512 inline __attribute__((always_inline)) __mmask16 step(const LaneGrid& g, const T* data,
-                                                                       const float* lut,
-                                                                       const LeapInverse& li, int b) {
-        const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
+    LACUNA_AVX512 inline __attribute__((always_inline)) __mmask16 step(
+        const LaneGrid& g, const T* data, const float* lut, const LeapInverse& li, int b) {
+        const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f),
+                     one = _mm512_set1_ps(1.f);
         const __m512i ione = _mm512_set1_epi32(1);
         const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
-        const __m512 t =
-            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), _mm512_set1_ps(g.dt)));
+        const __m512 t = _mm512_add_ps(
+            tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), _mm512_set1_ps(g.dt)));
         __m512 x = _mm512_add_ps(ox, _mm512_mul_ps(t, dx));
         __m512 y = _mm512_add_ps(oy, _mm512_mul_ps(t, dy));
         __m512 z = _mm512_add_ps(oz, _mm512_mul_ps(t, dz));
@@ -936,9 +993,10 @@ struct Group16 {
             const __m512i nj = _mm512_cvttps_epi32(_mm512_add_ps(y, half));
             const __m512i nk = _mm512_cvttps_epi32(_mm512_add_ps(z, half));
             const __m512i off = _mm512_maskz_mov_epi32(
-                active, _mm512_add_epi32(_mm512_add_epi32(_mm512_mullo_epi32(nk, _mm512_set1_epi32(g.sz)),
-                                                          _mm512_mullo_epi32(nj, _mm512_set1_epi32(g.sy))),
-                                         ni));
+                active,
+                _mm512_add_epi32(_mm512_add_epi32(_mm512_mullo_epi32(nk, _mm512_set1_epi32(g.sz)),
+                                                  _mm512_mullo_epi32(nj, _mm512_set1_epi32(g.sy))),
+                                 ni));
             if constexpr (std::is_same_v<T, float>) {
                 v = _mm512_i32gather_ps(off, reinterpret_cast<const float*>(data), 4);
             } else {
@@ -959,20 +1017,22 @@ struct Group16 {
         if constexpr (kLeap) {
             leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b);
             prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);
-            v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(g, data, x, y, z,
-                                                                std::is_integral_v<T> ? taken : active);
+            v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
+                g, data, x, y, z, std::is_integral_v<T> ? taken : active);
         }
         // A step on which every lane leaps composites nothing (their entries would be the
         // zero entry, which adds exact zeros): the LUT loads are skipped.
         if (!kLeap || taken) {
-            __m512 u = _mm512_add_ps(
-                _mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)), _mm512_set1_ps(g.lut_scale)), half);
+            __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)),
+                                                   _mm512_set1_ps(g.lut_scale)),
+                                     half);
             u = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.lut_last), u));
-            const __m512i entry =
-                _mm512_mask_blend_epi32(taken, _mm512_set1_epi32(g.zero_entry), _mm512_cvttps_epi32(u));
+            const __m512i entry = _mm512_mask_blend_epi32(taken, _mm512_set1_epi32(g.zero_entry),
+                                                          _mm512_cvttps_epi32(u));
             // RGBA of the 16 entries: sixteen 16-byte loads and a 4x4 transpose per 128-bit lane
             // (gathers cost ~1.4 cycles per element here; this is ~1.5 shuffles per sample). Lane j
-            // of q4[i] holds lane 4j + i's entry, so the transpose leaves the channels in lane order.
+            // of q4[i] holds lane 4j + i's entry, so the transpose leaves the channels in lane
+            // order.
             alignas(64) int32_t e[16];
             _mm512_store_si512(e, entry);
             __m512 q4[4];
@@ -982,12 +1042,18 @@ struct Group16 {
                 r = _mm512_insertf32x4(r, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[8 + i])), 2);
                 q4[i] = _mm512_insertf32x4(r, _mm_loadu_ps(lut + 4 * ptrdiff_t(e[12 + i])), 3);
             }
-            const __m512 t0 = _mm512_unpacklo_ps(q4[0], q4[1]), t1 = _mm512_unpackhi_ps(q4[0], q4[1]);
-            const __m512 t2 = _mm512_unpacklo_ps(q4[2], q4[3]), t3 = _mm512_unpackhi_ps(q4[2], q4[3]);
-            const __m512 cr = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
-            const __m512 cg = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
-            const __m512 cb = _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
-            const __m512 ca = _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
+            const __m512 t0 = _mm512_unpacklo_ps(q4[0], q4[1]),
+                         t1 = _mm512_unpackhi_ps(q4[0], q4[1]);
+            const __m512 t2 = _mm512_unpacklo_ps(q4[2], q4[3]),
+                         t3 = _mm512_unpackhi_ps(q4[2], q4[3]);
+            const __m512 cr =
+                _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
+            const __m512 cg =
+                _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t0), _mm512_castps_pd(t2)));
+            const __m512 cb =
+                _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
+            const __m512 ca =
+                _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(t1), _mm512_castps_pd(t3)));
             const __m512 w = _mm512_sub_ps(one, aa);
             ar = _mm512_add_ps(ar, _mm512_mul_ps(w, cr));
             ag = _mm512_add_ps(ag, _mm512_mul_ps(w, cg));
@@ -999,8 +1065,8 @@ struct Group16 {
             k = _mm512_min_epi32(_mm512_mask_add_epi32(k, valid, k, adv), kend);
         else
             k = _mm512_mask_add_epi32(k, valid, k, ione);
-        const __mmask16 over =
-            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, _mm512_set1_ps(g.ert), _CMP_GE_OS);
+        const __mmask16 over = _mm512_cmpeq_epi32_mask(k, kend) |
+                               _mm512_cmp_ps_mask(aa, _mm512_set1_ps(g.ert), _CMP_GE_OS);
         kend = _mm512_mask_mov_epi32(kend, over, k);  // a waiting lane takes no step
         return over & active;
     }
@@ -1008,7 +1074,7 @@ struct Group16 {
 
 template <bool kNearest, class T, class Refill, bool kLeap = false, int kGroups = 1>
 LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
-                                Refill& refill) {
+                                 Refill& refill) {
     static_assert(!(kLeap && kNearest), "leaping is for trilinear samples");
     static_assert(kGroups >= 1 && 16 * kGroups <= kMaxLanes);
     Group16<kNearest, T, kLeap> G[kGroups];
@@ -1020,7 +1086,8 @@ LACUNA_AVX512 void march_lanes16(Lanes& s, const LaneGrid& g, const T* data, con
     }
     for (;;) {
 #pragma GCC unroll 2
-        for (int i = 0; i < kGroups; ++i) waiting |= uint32_t(G[i].step(g, data, lut, linv, 16 * i)) << (16 * i);
+        for (int i = 0; i < kGroups; ++i)
+            waiting |= uint32_t(G[i].step(g, data, lut, linv, 16 * i)) << (16 * i);
         // Waiting lanes, as in the AVX2 kernel: refill once a quarter of the lanes wait.
         if (__builtin_popcount(waiting) >= 4 * kGroups || waiting == active) {
             for (int i = 0; i < kGroups; ++i) G[i].store(s, 16 * i);
@@ -1044,11 +1111,16 @@ LACUNA_AVX2 inline void setup_rays8(const CameraView& c, const float* px, const 
     const __m256 aspect = _mm256_set1_ps(c.width / c.height), hh = _mm256_set1_ps(c.half_h);
     // sx = (2 * (px + 0.5) / W - 1) * aspect * half_h;  sy = (1 - 2 * (py + 0.5) / H) * half_h
     const __m256 sx = _mm256_mul_ps(
-        _mm256_mul_ps(_mm256_sub_ps(_mm256_div_ps(_mm256_mul_ps(two, _mm256_add_ps(_mm256_loadu_ps(px), half)), w), one),
-                      aspect),
+        _mm256_mul_ps(
+            _mm256_sub_ps(
+                _mm256_div_ps(_mm256_mul_ps(two, _mm256_add_ps(_mm256_loadu_ps(px), half)), w),
+                one),
+            aspect),
         hh);
     const __m256 sy = _mm256_mul_ps(
-        _mm256_sub_ps(one, _mm256_div_ps(_mm256_mul_ps(two, _mm256_add_ps(_mm256_loadu_ps(py), half)), h)), hh);
+        _mm256_sub_ps(
+            one, _mm256_div_ps(_mm256_mul_ps(two, _mm256_add_ps(_mm256_loadu_ps(py), half)), h)),
+        hh);
     __m256 o[3], d[3];
     for (int a = 0; a < 3; ++a) {
         const __m256 r = _mm256_set1_ps(c.right[a]), u = _mm256_set1_ps(c.up[a]);
@@ -1063,8 +1135,9 @@ LACUNA_AVX2 inline void setup_rays8(const CameraView& c, const float* px, const 
         }
     }
     if (!c.ortho) {  // normalize: v / sqrt(x*x + y*y + z*z)
-        const __m256 len = _mm256_sqrt_ps(_mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])), _mm256_mul_ps(d[2], d[2])));
+        const __m256 len = _mm256_sqrt_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])),
+                          _mm256_mul_ps(d[2], d[2])));
         for (int a = 0; a < 3; ++a) d[a] = _mm256_div_ps(d[a], len);
     }
     _mm256_store_ps(out.wx, d[0]), _mm256_store_ps(out.wy, d[1]), _mm256_store_ps(out.wz, d[2]);
@@ -1076,17 +1149,20 @@ LACUNA_AVX2 inline void setup_rays8(const CameraView& c, const float* px, const 
         const __m256 vhi = _mm256_set1_ps(hi[a]);
         const __m256 flat = _mm256_cmp_ps(d[a], _mm256_setzero_ps(), _CMP_EQ_OQ);
         // d == 0: a miss if the origin lies outside [0, hi] on this axis; no slab otherwise.
-        miss = _mm256_or_ps(miss, _mm256_and_ps(flat, _mm256_or_ps(
-                                                        _mm256_cmp_ps(o[a], _mm256_setzero_ps(), _CMP_LT_OQ),
-                                                        _mm256_cmp_ps(o[a], vhi, _CMP_GT_OQ))));
+        miss = _mm256_or_ps(
+            miss,
+            _mm256_and_ps(flat, _mm256_or_ps(_mm256_cmp_ps(o[a], _mm256_setzero_ps(), _CMP_LT_OQ),
+                                             _mm256_cmp_ps(o[a], vhi, _CMP_GT_OQ))));
         const __m256 inv = _mm256_div_ps(one, d[a]);
         const __m256 ta = _mm256_mul_ps(_mm256_sub_ps(_mm256_setzero_ps(), o[a]), inv);
         const __m256 tb = _mm256_mul_ps(_mm256_sub_ps(vhi, o[a]), inv);
         const __m256 sw = _mm256_cmp_ps(ta, tb, _CMP_GT_OQ);
         const __m256 lo = _mm256_blendv_ps(ta, tb, sw), up = _mm256_blendv_ps(tb, ta, sw);
         // t0 = std::max(t0, lo) = t0 < lo ? lo : t0;  t1 = std::min(t1, up) = up < t1 ? up : t1
-        t0 = _mm256_blendv_ps(t0, _mm256_blendv_ps(t0, lo, _mm256_cmp_ps(t0, lo, _CMP_LT_OQ)), _mm256_xor_ps(flat, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
-        t1 = _mm256_blendv_ps(t1, _mm256_blendv_ps(t1, up, _mm256_cmp_ps(up, t1, _CMP_LT_OQ)), _mm256_xor_ps(flat, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+        t0 = _mm256_blendv_ps(t0, _mm256_blendv_ps(t0, lo, _mm256_cmp_ps(t0, lo, _CMP_LT_OQ)),
+                              _mm256_xor_ps(flat, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+        t1 = _mm256_blendv_ps(t1, _mm256_blendv_ps(t1, up, _mm256_cmp_ps(up, t1, _CMP_LT_OQ)),
+                              _mm256_xor_ps(flat, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
     }
     const __m256 hit = _mm256_andnot_ps(miss, _mm256_cmp_ps(t0, t1, _CMP_LT_OQ));
     _mm256_store_ps(out.ox, o[0]), _mm256_store_ps(out.oy, o[1]), _mm256_store_ps(out.oz, o[2]);

@@ -28,10 +28,10 @@ namespace lacuna::simd {
 
 // The sampled grid, as kernel::Grid holds it.
 struct ShadeGrid {
-    float hi[3];       // dims - 1
-    int32_t cell[3];   // dims - 2
-    int32_t sy, sz;    // strides of j and k
-    float inv_sp[3];   // 1 / spacing: index-space differences -> values per mm
+    float hi[3];                            // dims - 1
+    int32_t cell[3];                        // dims - 2
+    int32_t sy, sz;                         // strides of j and k
+    float inv_sp[3];                        // 1 / spacing: index-space differences -> values per mm
     float lut_offset, lut_scale, lut_last;  // ValueToLut
     const float* alpha;  // TF opacities, every 4th float (&Rgba::a of the front LUT)
     // The structure's visible-cell mask (accel/cell_ranges.h visible_cell_mask), or nullptr.
@@ -103,8 +103,9 @@ inline int samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const 
     const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f);
     const __m128 t = _mm_add_ps(
         _mm_set1_ps(r.t_base),
-        _mm_mul_ps(_mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k))), half),
-                   _mm_set1_ps(r.dt)));
+        _mm_mul_ps(
+            _mm_add_ps(_mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(k))), half),
+            _mm_set1_ps(r.dt)));
     const __m128 px = _mm_add_ps(_mm_set1_ps(r.o[0]), _mm_mul_ps(t, _mm_set1_ps(r.d[0])));
     const __m128 py = _mm_add_ps(_mm_set1_ps(r.o[1]), _mm_mul_ps(t, _mm_set1_ps(r.d[1])));
     const __m128 pz = _mm_add_ps(_mm_set1_ps(r.o[2]), _mm_mul_ps(t, _mm_set1_ps(r.d[2])));
@@ -114,8 +115,9 @@ inline int samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const 
         __m128i c[3];
         const __m128 p[3] = {px, py, pz};
         for (int a = 0; a < 3; ++a)
-            c[a] = _mm_min_epi32(_mm_cvttps_epi32(_mm_max_ps(zero, _mm_min_ps(_mm_set1_ps(g.hi[a]), p[a]))),
-                                 _mm_set1_epi32(g.cell[a]));
+            c[a] = _mm_min_epi32(
+                _mm_cvttps_epi32(_mm_max_ps(zero, _mm_min_ps(_mm_set1_ps(g.hi[a]), p[a]))),
+                _mm_set1_epi32(g.cell[a]));
         alignas(16) uint32_t o[4];
         _mm_store_si128(reinterpret_cast<__m128i*>(o),
                         _mm_add_epi32(_mm_add_epi32(_mm_mullo_epi32(c[2], _mm_set1_epi32(g.sz)),
@@ -127,7 +129,8 @@ inline int samples4(const ShadeGrid& g, const ShadeRay& r, const T* data, const 
     }
     const __m128 val = trilinear4(g, data, px, py, pz);
     _mm_storeu_ps(v, val);
-    __m128 u = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(val, _mm_set1_ps(g.lut_offset)), _mm_set1_ps(g.lut_scale)), half);
+    __m128 u = _mm_add_ps(
+        _mm_mul_ps(_mm_sub_ps(val, _mm_set1_ps(g.lut_offset)), _mm_set1_ps(g.lut_scale)), half);
     u = _mm_max_ps(zero, _mm_min_ps(_mm_set1_ps(g.lut_last), u));
     const __m128i ent = _mm_cvttps_epi32(u);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(e), ent);
@@ -168,11 +171,15 @@ LACUNA_AVX2 int samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, c
     const __m256 t = _mm256_add_ps(
         _mm256_set1_ps(r.t_base),
         _mm256_mul_ps(
-            _mm256_add_ps(_mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k))), half),
+            _mm256_add_ps(
+                _mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(k))), half),
             _mm256_set1_ps(r.dt)));
-    const __m256 px = _mm256_add_ps(_mm256_set1_ps(r.o[0]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[0])));
-    const __m256 py = _mm256_add_ps(_mm256_set1_ps(r.o[1]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[1])));
-    const __m256 pz = _mm256_add_ps(_mm256_set1_ps(r.o[2]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[2])));
+    const __m256 px =
+        _mm256_add_ps(_mm256_set1_ps(r.o[0]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[0])));
+    const __m256 py =
+        _mm256_add_ps(_mm256_set1_ps(r.o[1]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[1])));
+    const __m256 pz =
+        _mm256_add_ps(_mm256_set1_ps(r.o[2]), _mm256_mul_ps(t, _mm256_set1_ps(r.d[2])));
     _mm256_storeu_ps(x, px), _mm256_storeu_ps(y, py), _mm256_storeu_ps(z, pz);
     if (g.cell_mask) {
         // The cells trilinear8 reads (its clamp and truncation), one gather from the mask.
@@ -185,20 +192,22 @@ LACUNA_AVX2 int samples8(const ShadeGrid& g, const ShadeRay& r, const T* data, c
         const __m256i ck = _mm256_min_epi32(
             _mm256_cvttps_epi32(_mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.hi[2]), pz))),
             _mm256_set1_epi32(g.cell[2]));
-        const __m256i off = _mm256_add_epi32(
-            _mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
-                             _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
-            ci);
+        const __m256i off =
+            _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(ck, _mm256_set1_epi32(g.sz)),
+                                              _mm256_mullo_epi32(cj, _mm256_set1_epi32(g.sy))),
+                             ci);
         const __m256i w = _mm256_i32gather_epi32(reinterpret_cast<const int*>(g.cell_mask),
                                                  _mm256_srli_epi32(off, 5), 4);
-        const __m256i bit = _mm256_and_si256(
-            _mm256_srlv_epi32(w, _mm256_and_si256(off, _mm256_set1_epi32(31))), _mm256_set1_epi32(1));
+        const __m256i bit =
+            _mm256_and_si256(_mm256_srlv_epi32(w, _mm256_and_si256(off, _mm256_set1_epi32(31))),
+                             _mm256_set1_epi32(1));
         if (_mm256_testz_si256(bit, bit)) return 0;
     }
     const __m256 val = trilinear8(g, data, px, py, pz);
     _mm256_storeu_ps(v, val);
-    __m256 u = _mm256_add_ps(
-        _mm256_mul_ps(_mm256_sub_ps(val, _mm256_set1_ps(g.lut_offset)), _mm256_set1_ps(g.lut_scale)), half);
+    __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(val, _mm256_set1_ps(g.lut_offset)),
+                                           _mm256_set1_ps(g.lut_scale)),
+                             half);
     u = _mm256_max_ps(zero, _mm256_min_ps(_mm256_set1_ps(g.lut_last), u));
     const __m256i ent = _mm256_cvttps_epi32(u);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(e), ent);
@@ -221,7 +230,8 @@ LACUNA_AVX2 inline __attribute__((always_inline)) __m256 lerp8(__m256 a, __m256 
 template <class T>
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256 voxel_field8(__m256i w, int f) {
     if constexpr (sizeof(T) == 1)
-        return _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 8 * f), _mm256_set1_epi32(0xff)));
+        return _mm256_cvtepi32_ps(
+            _mm256_and_si256(_mm256_srli_epi32(w, 8 * f), _mm256_set1_epi32(0xff)));
     else if constexpr (std::is_signed_v<T>)
         return _mm256_cvtepi32_ps(f == 0 ? _mm256_srai_epi32(_mm256_slli_epi32(w, 16), 16)
                                          : _mm256_srai_epi32(w, 16));
@@ -249,7 +259,8 @@ LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, 
             f[a] = _mm256_sub_ps(p[a], _mm256_cvtepi32_ps(c[a]));
             // 1 <= c <= cell - 1: the rows c-1 .. c+2 are inside the grid.
             inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(c[a], _mm256_setzero_si256()));
-            inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(_mm256_set1_epi32(g.cell[a]), c[a]));
+            inside =
+                _mm256_and_si256(inside, _mm256_cmpgt_epi32(_mm256_set1_epi32(g.cell[a]), c[a]));
         }
         // Lanes on a face: central_gradient at the end; their rows are read at cell (1, 1, 1).
         // Lanes n.. are padding: whatever they hold, never the scalar path.
@@ -260,10 +271,11 @@ LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, 
         }
         for (int a = 0; a < 3; ++a) c[a] = _mm256_blendv_epi8(_mm256_set1_epi32(1), c[a], inside);
         alignas(32) int32_t o[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(o),
-                           _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(c[2], _mm256_set1_epi32(g.sz)),
-                                                             _mm256_mullo_epi32(c[1], _mm256_set1_epi32(g.sy))),
-                                            c[0]));
+        _mm256_store_si256(
+            reinterpret_cast<__m256i*>(o),
+            _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(c[2], _mm256_set1_epi32(g.sz)),
+                                              _mm256_mullo_epi32(c[1], _mm256_set1_epi32(g.sy))),
+                             c[0]));
         // Per lane: rows[r] = v(i-1 .. i+2) at (j + (r & 1), k + (r >> 1)) (16-bit voxels: the
         // low pair i-1, i in rows[r], the high pair i+1, i+2 in rows[4 + r]); the pairs v(i, i+1)
         // at y = j-1 (ym), j+2 (yp) for z = k, k+1 and at z = k-1 (zm), k+2 (zp) for y = j, j+1.
@@ -305,8 +317,9 @@ LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, 
         for (int q = 0; q < 8; ++q) {
             const int a = q & 1, b = q >> 1 & 1, cz = q >> 2;
             d[0][q] = _mm256_sub_ps(R[b + 2 * cz][a + 2], R[b + 2 * cz][a]);
-            d[1][q] = b == 0 ? _mm256_sub_ps(R[1 + 2 * cz][a + 1], voxel_field8<T>(load8(ym[cz]), a))
-                             : _mm256_sub_ps(voxel_field8<T>(load8(yp[cz]), a), R[2 * cz][a + 1]);
+            d[1][q] = b == 0
+                          ? _mm256_sub_ps(R[1 + 2 * cz][a + 1], voxel_field8<T>(load8(ym[cz]), a))
+                          : _mm256_sub_ps(voxel_field8<T>(load8(yp[cz]), a), R[2 * cz][a + 1]);
             d[2][q] = cz == 0 ? _mm256_sub_ps(R[b + 2][a + 1], voxel_field8<T>(load8(zm[b]), a))
                               : _mm256_sub_ps(voxel_field8<T>(load8(zp[b]), a), R[b][a + 1]);
         }
@@ -358,7 +371,7 @@ struct PbrLanes {
 };
 
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256 dot8(__m256 ax, __m256 ay, __m256 az,
-                                                             const float* b) {
+                                                              const float* b) {
     return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ax, _mm256_set1_ps(b[0])),
                                        _mm256_mul_ps(ay, _mm256_set1_ps(b[1]))),
                          _mm256_mul_ps(az, _mm256_set1_ps(b[2])));
@@ -371,19 +384,19 @@ LACUNA_AVX2 inline __attribute__((always_inline)) Dir8 dir8(const float* d) {
     return {_mm256_set1_ps(d[0]), _mm256_set1_ps(d[1]), _mm256_set1_ps(d[2])};
 }
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256 dot8(__m256 ax, __m256 ay, __m256 az,
-                                                             const Dir8& b) {
+                                                              const Dir8& b) {
     return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ax, b.x), _mm256_mul_ps(ay, b.y)),
                          _mm256_mul_ps(az, b.z));
 }
 
 // The normals of normal_from_gradient, facing v; the mask of lanes with a non-zero gradient.
 LACUNA_AVX2 inline __attribute__((always_inline)) __m256 normals8(const float* gx, const float* gy,
-                                                                 const float* gz, const Dir8& v,
-                                                                 __m256& nx, __m256& ny,
-                                                                 __m256& nz) {
+                                                                  const float* gz, const Dir8& v,
+                                                                  __m256& nx, __m256& ny,
+                                                                  __m256& nz) {
     const __m256 x = _mm256_loadu_ps(gx), y = _mm256_loadu_ps(gy), z = _mm256_loadu_ps(gz);
-    const __m256 len2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)),
-                                      _mm256_mul_ps(z, z));
+    const __m256 len2 =
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
     const __m256 ok = _mm256_cmp_ps(len2, _mm256_setzero_ps(), _CMP_GT_OQ);
     const __m256 inv = _mm256_div_ps(_mm256_set1_ps(-1.f), _mm256_sqrt_ps(len2));
     nx = _mm256_mul_ps(x, inv), ny = _mm256_mul_ps(y, inv), nz = _mm256_mul_ps(z, inv);
@@ -417,7 +430,8 @@ LACUNA_AVX2 inline void phong8(const PhongLanes& p, float li, const Dir8& l, con
     alignas(32) float spec[8] = {};
     if (_mm256_movemask_ps(h_ok)) {
         const __m256 vndh = _mm256_max_ps(zero, dot8(nx, ny, nz, h));
-        const __m256 vlit = _mm256_and_ps(_mm256_and_ps(ok, h_ok), _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ));
+        const __m256 vlit =
+            _mm256_and_ps(_mm256_and_ps(ok, h_ok), _mm256_cmp_ps(ndl, zero, _CMP_GT_OQ));
         if (integer_power(p.power)) {
             _mm256_store_ps(spec, _mm256_and_ps(vlit, spec_pow8(vndh, int(p.power))));
         } else {
@@ -429,9 +443,11 @@ LACUNA_AVX2 inline void phong8(const PhongLanes& p, float li, const Dir8& l, con
         }
     }
     const __m256 vli = _mm256_set1_ps(li);
-    const __m256 k = _mm256_add_ps(_mm256_set1_ps(p.ambient),
-                                   _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.diffuse), vli), ndl));
-    const __m256 sp = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.specular), vli), _mm256_load_ps(spec));
+    const __m256 k =
+        _mm256_add_ps(_mm256_set1_ps(p.ambient),
+                      _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.diffuse), vli), ndl));
+    const __m256 sp =
+        _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(p.specular), vli), _mm256_load_ps(spec));
     float* c[3] = {r, g, b};
     for (int i = 0; i < 3; ++i) {
         const __m256 in = _mm256_loadu_ps(c[i]);
@@ -472,10 +488,12 @@ LACUNA_AVX2 inline void pbr8(const PbrLanes& p, const ShadeLight& L, const float
     const __m256 vli = _mm256_set1_ps(L.li);
     const __m256 diffuse = _mm256_mul_ps(_mm256_mul_ps(vli, _mm256_mul_ps(fl, fv)), ndl);
     // ggx_d
-    const __m256 d = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(ndh, ndh), _mm256_set1_ps(a2 - 1.f)), one);
+    const __m256 d =
+        _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(ndh, ndh), _mm256_set1_ps(a2 - 1.f)), one);
     const __m256 kpi = _mm256_set1_ps(3.14159265358979f);
-    const __m256 D = _mm256_div_ps(_mm256_set1_ps(a2), _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(kpi, d), d),
-                                                                     _mm256_set1_ps(1e-7f)));
+    const __m256 D = _mm256_div_ps(
+        _mm256_set1_ps(a2),
+        _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(kpi, d), d), _mm256_set1_ps(1e-7f)));
     // smith_joint_ggx_v
     const __m256 one_a2 = _mm256_set1_ps(1.f - a2), va2 = _mm256_set1_ps(a2);
     const __m256 gl = _mm256_mul_ps(
@@ -499,7 +517,8 @@ LACUNA_AVX2 inline void pbr8(const PbrLanes& p, const ShadeLight& L, const float
         __m256 fs = _mm256_sub_ps(one, f0);
         for (int q = 0; q < 5; ++q) fs = _mm256_mul_ps(fs, sm);
         const __m256 F = _mm256_add_ps(f0, fs);
-        const __m256 out = _mm256_add_ps(_mm256_mul_ps(kd, amb_diff), _mm256_mul_ps(spec_common, F));
+        const __m256 out =
+            _mm256_add_ps(_mm256_mul_ps(kd, amb_diff), _mm256_mul_ps(spec_common, F));
         _mm256_storeu_ps(c[i], _mm256_blendv_ps(in, out, ok));
     }
 }
@@ -514,12 +533,16 @@ template <class T>
 LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data, const int32_t* k,
                             float* x, float* y, float* z, float* v, int32_t* e) {
     const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f);
-    const __m512 t = _mm512_add_ps(
-        _mm512_set1_ps(r.t_base),
-        _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(_mm512_loadu_si512(k)), half), _mm512_set1_ps(r.dt)));
-    const __m512 px = _mm512_add_ps(_mm512_set1_ps(r.o[0]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[0])));
-    const __m512 py = _mm512_add_ps(_mm512_set1_ps(r.o[1]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[1])));
-    const __m512 pz = _mm512_add_ps(_mm512_set1_ps(r.o[2]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[2])));
+    const __m512 t =
+        _mm512_add_ps(_mm512_set1_ps(r.t_base),
+                      _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(_mm512_loadu_si512(k)), half),
+                                    _mm512_set1_ps(r.dt)));
+    const __m512 px =
+        _mm512_add_ps(_mm512_set1_ps(r.o[0]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[0])));
+    const __m512 py =
+        _mm512_add_ps(_mm512_set1_ps(r.o[1]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[1])));
+    const __m512 pz =
+        _mm512_add_ps(_mm512_set1_ps(r.o[2]), _mm512_mul_ps(t, _mm512_set1_ps(r.d[2])));
     _mm512_storeu_ps(x, px), _mm512_storeu_ps(y, py), _mm512_storeu_ps(z, pz);
     const __m512 cx = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), px));
     const __m512 cy = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), py));
@@ -529,19 +552,21 @@ LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data
         const __m512i ci = _mm512_min_epi32(_mm512_cvttps_epi32(cx), _mm512_set1_epi32(g.cell[0]));
         const __m512i cj = _mm512_min_epi32(_mm512_cvttps_epi32(cy), _mm512_set1_epi32(g.cell[1]));
         const __m512i ck = _mm512_min_epi32(_mm512_cvttps_epi32(cz), _mm512_set1_epi32(g.cell[2]));
-        const __m512i off = _mm512_add_epi32(
-            _mm512_add_epi32(_mm512_mullo_epi32(ck, _mm512_set1_epi32(g.sz)),
-                             _mm512_mullo_epi32(cj, _mm512_set1_epi32(g.sy))),
-            ci);
+        const __m512i off =
+            _mm512_add_epi32(_mm512_add_epi32(_mm512_mullo_epi32(ck, _mm512_set1_epi32(g.sz)),
+                                              _mm512_mullo_epi32(cj, _mm512_set1_epi32(g.sy))),
+                             ci);
         const __m512i w = _mm512_i32gather_epi32(_mm512_srli_epi32(off, 5), g.cell_mask, 4);
-        const __m512i bit = _mm512_and_si512(_mm512_srlv_epi32(w, _mm512_and_si512(off, _mm512_set1_epi32(31))),
-                                             _mm512_set1_epi32(1));
+        const __m512i bit =
+            _mm512_and_si512(_mm512_srlv_epi32(w, _mm512_and_si512(off, _mm512_set1_epi32(31))),
+                             _mm512_set1_epi32(1));
         if (!_mm512_test_epi32_mask(bit, bit)) return 0;
     }
     const __m512 val = trilinear16(g, data, cx, cy, cz, __mmask16(0xffff));
     _mm512_storeu_ps(v, val);
-    __m512 u = _mm512_add_ps(
-        _mm512_mul_ps(_mm512_sub_ps(val, _mm512_set1_ps(g.lut_offset)), _mm512_set1_ps(g.lut_scale)), half);
+    __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(val, _mm512_set1_ps(g.lut_offset)),
+                                           _mm512_set1_ps(g.lut_scale)),
+                             half);
     u = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.lut_last), u));
     const __m512i ent = _mm512_cvttps_epi32(u);
     _mm512_storeu_si512(e, ent);
@@ -554,10 +579,11 @@ LACUNA_AVX512 int samples16(const ShadeGrid& g, const ShadeRay& r, const T* data
 // march_shaded_lanes8 is march_lanes8 (core/simd_lanes.h) for Phong-shaded composite rays with
 // a head or directional light, one TF, no clipping, trilinear samples; the render side
 // (src/render/feature_render.cpp) takes it with leaping on a refined grid, where it pays (alone,
-// walking the grid, it measured no faster than ShadedStream). ShadedStream (src/render/feature_kernel.h) shades one ray
-// at a time: a ray keeps ~25 samples, of which ~4 are visible, so its lattice and its gradient
-// batches run mostly empty lanes. Here lanes are rays, as in the unshaded kernel, and the
-// visible samples of all lanes go to one queue, shaded eight at a time whoever they belong to.
+// walking the grid, it measured no faster than ShadedStream). ShadedStream
+// (src/render/feature_kernel.h) shades one ray at a time: a ray keeps ~25 samples, of which ~4 are
+// visible, so its lattice and its gradient batches run mostly empty lanes. Here lanes are rays, as
+// in the unshaded kernel, and the visible samples of all lanes go to one queue, shaded eight at a
+// time whoever they belong to.
 //
 // Bit-exactness. Per lane, the lattice positions, values and LUT entries are march_lanes8's
 // (ShadedStream's, operation for operation), and the opacity chain w = 1 - A, A += w * a runs on
@@ -583,7 +609,8 @@ struct ShadeRecords {
 // batch's padding.
 inline constexpr int kShadeQueue = 32;
 struct ShadeQueue {
-    alignas(64) float x[kShadeQueue], y[kShadeQueue], z[kShadeQueue], w[kShadeQueue], a[kShadeQueue];
+    alignas(64) float x[kShadeQueue], y[kShadeQueue], z[kShadeQueue], w[kShadeQueue],
+        a[kShadeQueue];
     alignas(64) int32_t e[kShadeQueue], rec[kShadeQueue];
     int n = 0;
 };
@@ -604,19 +631,22 @@ struct ShadeFrame {
 // The per-ray half vectors of eight rays of a RayBatch8 (the shaded lanes' records), with
 // shading::half_vector's operations lane by lane: v = -w, l = `ldir` (a head light: v),
 // h = (l + v) / |l + v| and ok = -1 where |l + v| > 0, else h = (0, 0, 1) and ok = 0.
-LACUNA_AVX2 inline void half_vectors8(const RayBatch8& rb, bool head, const float ldir[3], float (*h)[8],
-                                      int32_t* ok) {
+LACUNA_AVX2 inline void half_vectors8(const RayBatch8& rb, bool head, const float ldir[3],
+                                      float (*h)[8], int32_t* ok) {
     const __m256 sign = _mm256_set1_ps(-0.f);
-    const __m256 v[3] = {_mm256_xor_ps(_mm256_load_ps(rb.wx), sign), _mm256_xor_ps(_mm256_load_ps(rb.wy), sign),
+    const __m256 v[3] = {_mm256_xor_ps(_mm256_load_ps(rb.wx), sign),
+                         _mm256_xor_ps(_mm256_load_ps(rb.wy), sign),
                          _mm256_xor_ps(_mm256_load_ps(rb.wz), sign)};
     __m256 s[3];
     for (int a = 0; a < 3; ++a) s[a] = _mm256_add_ps(head ? v[a] : _mm256_set1_ps(ldir[a]), v[a]);
     const __m256 len = _mm256_sqrt_ps(
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(s[0], s[0]), _mm256_mul_ps(s[1], s[1])), _mm256_mul_ps(s[2], s[2])));
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(s[0], s[0]), _mm256_mul_ps(s[1], s[1])),
+                      _mm256_mul_ps(s[2], s[2])));
     const __m256 good = _mm256_cmp_ps(len, _mm256_setzero_ps(), _CMP_GT_OQ);
     const float unit[3] = {0.f, 0.f, 1.f};
     for (int a = 0; a < 3; ++a)
-        _mm256_store_ps(h[a], _mm256_blendv_ps(_mm256_set1_ps(unit[a]), _mm256_div_ps(s[a], len), good));
+        _mm256_store_ps(h[a],
+                        _mm256_blendv_ps(_mm256_set1_ps(unit[a]), _mm256_div_ps(s[a], len), good));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(ok), _mm256_castps_si256(good));
 }
 
@@ -646,10 +676,12 @@ LACUNA_AVX2 void shade_run8(const ShadeFrame& f, const T* data, ShadeQueue& q, i
         r[j] = c[0], g[j] = c[1], b[j] = c[2];
     }
     const __m256i rec = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(qrec));
-    const __m256 h_ok = _mm256_castsi256_ps(
-        _mm256_i32gather_epi32(reinterpret_cast<const int*>(R.h_ok), rec, 4));
+    const __m256 h_ok =
+        _mm256_castsi256_ps(_mm256_i32gather_epi32(reinterpret_cast<const int*>(R.h_ok), rec, 4));
     const Dir8 v = gather_dir8(R.v, rec);
-    const Dir8 l = f.head ? v : Dir8{_mm256_set1_ps(f.dir[0]), _mm256_set1_ps(f.dir[1]), _mm256_set1_ps(f.dir[2])};
+    const Dir8 l =
+        f.head ? v
+               : Dir8{_mm256_set1_ps(f.dir[0]), _mm256_set1_ps(f.dir[1]), _mm256_set1_ps(f.dir[2])};
     phong8(f.phong, f.li, l, v, gather_dir8(R.h, rec), h_ok, gx, gy, gz, r, g, b, n);
     for (int j = 0; j < n; ++j) {
         const int i = qrec[j];
@@ -699,16 +731,16 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
     const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
     __m256 ox, oy, oz, dx, dy, dz, tb, aa;
     __m256i kend, active, k, n;
-#define LACUNA_LOAD_LANES                                                             \
-    ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz);  \
-    dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz);  \
-    tb = _mm256_load_ps(s.t_base);                                                    \
-    kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));               \
-    active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));           \
-    k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));                     \
-    n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                     \
-    aa = _mm256_load_ps(s.a);                                                         \
-    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                    \
+#define LACUNA_LOAD_LANES                                                            \
+    ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz); \
+    dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz); \
+    tb = _mm256_load_ps(s.t_base);                                                   \
+    kend = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kend));              \
+    active = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.active));          \
+    k = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.k));                    \
+    n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                    \
+    aa = _mm256_load_ps(s.a);                                                        \
+    active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                   \
     if constexpr (kLeap) leap_inverse8(dx, dy, dz, g.leap_octant, linv);
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
@@ -770,25 +802,27 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
 #undef LACUNA_LOAD_LANES
 }
 
-
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-// ---- Shading across rays (AVX-512): sixteen lanes ------------------------------------------------
-// march_shaded_lanes8 with march_lanes16's lane set (sixteen rays, trilinear16, leap16): per lane
-// the same operations, so the same bits. The visible samples of a lane set enter the queue by
-// compression in lane order (a ray's samples stay in its sample order: one per lane and
-// iteration), and every full eight is shaded by shade_run8. Two groups of sixteen lanes are in
-// flight, as in march_lanes16 (simd_lanes.h, Group16: two independent leap chains); a ray's
-// samples still enter the queue in its own order, one per step of its group.
+// ---- Shading across rays (AVX-512): sixteen lanes
+// ------------------------------------------------ march_shaded_lanes8 with march_lanes16's lane
+// set (sixteen rays, trilinear16, leap16): per lane the same operations, so the same bits. The
+// visible samples of a lane set enter the queue by compression in lane order (a ray's samples stay
+// in its sample order: one per lane and iteration), and every full eight is shaded by shade_run8.
+// Two groups of sixteen lanes are in flight, as in march_lanes16 (simd_lanes.h, Group16: two
+// independent leap chains); a ray's samples still enter the queue in its own order, one per step of
+// its group.
 template <class T>
 struct ShadedGroup16 {
     __m512 ox, oy, oz, dx, dy, dz, tb, aa;
     __m512i kend, k, n, vrec;
     __mmask16 active;
 
-    LACUNA_AVX512 inline __attribute__((always_inline)) void load(const Lanes& s, int b, const LaneGrid& g,
-                                                                  const int32_t* rec, LeapInverse& li) {
+    LACUNA_AVX512 inline __attribute__((always_inline)) void load(const Lanes& s, int b,
+                                                                  const LaneGrid& g,
+                                                                  const int32_t* rec,
+                                                                  LeapInverse& li) {
         ox = _mm512_load_ps(s.ox + b), oy = _mm512_load_ps(s.oy + b), oz = _mm512_load_ps(s.oz + b);
         dx = _mm512_load_ps(s.dx + b), dy = _mm512_load_ps(s.dy + b), dz = _mm512_load_ps(s.dz + b);
         tb = _mm512_load_ps(s.t_base + b);
@@ -808,16 +842,15 @@ struct ShadedGroup16 {
     }
     // One sample (or leap) per valid lane, its visible samples queued; returns the active lanes
     // whose run is over.
-    LACUNA_AVX512 inline __attribute__((always_inline)) __mmask16 step(const LaneGrid& g, const T* data,
-                                                                       const float* lut, const ShadeFrame& f,
-                                                                       ShadeQueue& q, ShadeRecords& R,
-                                                                       const int32_t* rec,
-                                                                       const LeapInverse& li, int b) {
-        const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f);
+    LACUNA_AVX512 inline __attribute__((always_inline)) __mmask16 step(
+        const LaneGrid& g, const T* data, const float* lut, const ShadeFrame& f, ShadeQueue& q,
+        ShadeRecords& R, const int32_t* rec, const LeapInverse& li, int b) {
+        const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f),
+                     one = _mm512_set1_ps(1.f);
         const __m512i ione = _mm512_set1_epi32(1);
         const __mmask16 valid = _mm512_cmplt_epi32_mask(k, kend);
-        const __m512 t =
-            _mm512_add_ps(tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), _mm512_set1_ps(g.dt)));
+        const __m512 t = _mm512_add_ps(
+            tb, _mm512_mul_ps(_mm512_add_ps(_mm512_cvtepi32_ps(k), half), _mm512_set1_ps(g.dt)));
         const __m512 px = _mm512_add_ps(ox, _mm512_mul_ps(t, dx));
         const __m512 py = _mm512_add_ps(oy, _mm512_mul_ps(t, dy));
         const __m512 pz = _mm512_add_ps(oz, _mm512_mul_ps(t, dz));
@@ -831,8 +864,9 @@ struct ShadedGroup16 {
         // (only the lanes that take their sample load its corners: trilinear16's kSparse)
         const __m512 v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
             g, data, x, y, z, std::is_integral_v<T> ? taken : active);
-        __m512 u = _mm512_add_ps(
-            _mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)), _mm512_set1_ps(g.lut_scale)), half);
+        __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)),
+                                               _mm512_set1_ps(g.lut_scale)),
+                                 half);
         u = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.lut_last), u));
         const __m512i entry =
             _mm512_mask_blend_epi32(taken, _mm512_set1_epi32(g.zero_entry), _mm512_cvttps_epi32(u));
@@ -856,17 +890,17 @@ struct ShadedGroup16 {
         }
         n = _mm512_mask_add_epi32(n, taken, n, ione);
         k = _mm512_min_epi32(_mm512_mask_add_epi32(k, valid, k, adv), kend);
-        const __mmask16 over =
-            _mm512_cmpeq_epi32_mask(k, kend) | _mm512_cmp_ps_mask(aa, _mm512_set1_ps(g.ert), _CMP_GE_OS);
+        const __mmask16 over = _mm512_cmpeq_epi32_mask(k, kend) |
+                               _mm512_cmp_ps_mask(aa, _mm512_set1_ps(g.ert), _CMP_GE_OS);
         kend = _mm512_mask_mov_epi32(kend, over, k);
         return over & active;
     }
 };
 
 template <class T, class Refill, int kGroups = 2>
-LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* data, const float* lut,
-                                       const ShadeFrame& f, ShadeQueue& q, ShadeRecords& R,
-                                       const int32_t* rec, Refill& refill) {
+LACUNA_AVX512 void march_shaded_lanes16(Lanes& s, const LaneGrid& g, const T* data,
+                                        const float* lut, const ShadeFrame& f, ShadeQueue& q,
+                                        ShadeRecords& R, const int32_t* rec, Refill& refill) {
     static_assert(kGroups >= 1 && 16 * kGroups <= kMaxLanes);
     ShadedGroup16<T> G[kGroups];
     LeapInverse linv;

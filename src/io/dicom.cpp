@@ -373,7 +373,8 @@ void read_series_child(const std::string& dir, const MemoryBudget& budget, int m
     // reads as DICOM, or named .dcm) and is in no series is an error; other files (notes,
     // thumbnails) are ignored.
     for (const auto& [path, walk] : walks)
-        if ((walk.part10 || walk.dicom || to_lower(fs::path(path).extension().string()) == ".dcm") &&
+        if ((walk.part10 || walk.dicom ||
+             to_lower(fs::path(path).extension().string()) == ".dcm") &&
             !series.in_any.count(path))
             throw Error(dir, file_name(path),
                         "is a DICOM file that GDCM could not place in any series (damaged?)");

@@ -134,8 +134,7 @@ bool guess_encoding(const ReadAt& read, uint64_t base, Encoding& enc, const std:
 // would keep the walk busy for nothing.
 constexpr int kMaxElements = 1 << 20;
 
-DicomWalk walk(const ReadAt& read, uint64_t size, const std::string& name,
-               const std::string& dir) {
+DicomWalk walk(const ReadAt& read, uint64_t size, const std::string& name, const std::string& dir) {
     DicomWalk w;
     uint8_t h[12];
     uint64_t pos = 0;

@@ -11,9 +11,10 @@
 //     them, and GDCM reads them): from byte 0, in the encoding GDCM's
 //     FileMetaInformation::ReadCompat guesses from the first tag (a group 0002 meta group;
 //     group 0008 little endian, explicit if a VR follows; group 0800 big endian; element 0010
-//     little endian, explicit if a VR follows; else explicit if a VR follows, big endian when the tag reads
-//     above 0xFF). A file whose first tag fits none of these is not DICOM to GDCM either, which
-//     gives up on it before reading any value (notes, thumbnails): no verdict, the walk stops.
+//     little endian, explicit if a VR follows; else explicit if a VR follows, big endian when the
+//     tag reads above 0xFF). A file whose first tag fits none of these is not DICOM to GDCM either,
+//     which gives up on it before reading any value (notes, thumbnails): no verdict, the walk
+//     stops.
 // Every element with a defined length must end inside the file, up to the last one (GDCM also
 // reads what follows the Pixel Data: a 1710-byte slice with a junk element after it made GDCM
 // allocate 3.9 GB; and a 12-byte file without a preamble whose first element, (0002,0000) in

@@ -137,7 +137,8 @@ void check_nrrd_geometry(const std::string& header) {
         bool finite = true;
         if (!nrrd_vectors(value, vectors, finite)) return;  // NrrdIO's to judge
         if (!finite)
-            throw Error(header, key, "expected finite coordinates, got '" + one_line(value, 120) + "'");
+            throw Error(header, key,
+                        "expected finite coordinates, got '" + one_line(value, 120) + "'");
         if (key != "space directions") return;
         for (size_t a = 0; a < vectors.size(); ++a) {
             const std::vector<double>& v = vectors[a];

@@ -149,8 +149,9 @@ void write_png(const std::string& path, const Image& img) {
 std::string png_bytes(const Image& img) {
     if (img.width <= 0 || img.height <= 0 ||
         img.rgba.size() != size_t(img.width) * size_t(img.height) * 4)
-        throw Error("png", "image", "invalid image " + std::to_string(img.width) + "x" +
-                                        std::to_string(img.height));
+        throw Error(
+            "png", "image",
+            "invalid image " + std::to_string(img.width) + "x" + std::to_string(img.height));
     // open_memstream: a FILE over a growing buffer, so encode_png writes exactly what it writes
     // to a file. buf and size are valid after fclose.
     char* buf = nullptr;
@@ -162,7 +163,9 @@ std::string png_bytes(const Image& img) {
     const bool failed = std::fclose(fp) != 0 || rc != 0;
     std::string out = failed || !buf ? std::string() : std::string(buf, size);
     std::free(buf);
-    if (failed) throw Error("png", "image", std::string("cannot encode: ") + (msg.text[0] ? msg.text : "out of memory"));
+    if (failed)
+        throw Error("png", "image",
+                    std::string("cannot encode: ") + (msg.text[0] ? msg.text : "out of memory"));
     return out;
 }
 

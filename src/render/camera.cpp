@@ -68,8 +68,8 @@ Ray Camera::generate(float px, float py) const {
 }
 
 std::string to_string(const Camera& c) {
-    return std::string(c.m_projection == Projection::Orthographic ? "ortho" : "persp") +
-           " eye " + to_string(c.m_eye) + " forward " + to_string(c.m_forward) + " " +
+    return std::string(c.m_projection == Projection::Orthographic ? "ortho" : "persp") + " eye " +
+           to_string(c.m_eye) + " forward " + to_string(c.m_forward) + " " +
            std::to_string(c.m_width) + "x" + std::to_string(c.m_height);
 }
 

@@ -28,16 +28,16 @@
 #include <type_traits>
 
 #include "accel/cursor.h"
-#include "render/lane_scheduler.h"
-#include "render/pixel_driver.h"
 #include "accel/entry_window.h"
 #include "accel/no_accel.h"
+#include "core/gradient.h"
 #include "core/parallel.h"
+#include "core/simd_shading.h"
 #include "lacuna/camera.h"
 #include "lacuna/image.h"
 #include "lacuna/renderer.h"
-#include "core/gradient.h"
-#include "core/simd_shading.h"
+#include "render/lane_scheduler.h"
+#include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 #include "render/shading.h"
 
@@ -56,8 +56,15 @@ inline HalfSpace to_index(const ClipPlane& p, Vec3f sp) {
 
 // A float grid sampled with the renderer's trilinear() (gradient and light volumes).
 inline kernel::Grid<float, int64_t> float_grid(const float* data, const int m[3]) {
-    return {data, ptrdiff_t(m[0]), ptrdiff_t(m[0]) * m[1], float(m[0] - 1), float(m[1] - 1),
-            float(m[2] - 1), m[0] - 2, m[1] - 2, m[2] - 2};
+    return {data,
+            ptrdiff_t(m[0]),
+            ptrdiff_t(m[0]) * m[1],
+            float(m[0] - 1),
+            float(m[1] - 1),
+            float(m[2] - 1),
+            m[0] - 2,
+            m[1] - 2,
+            m[2] - 2};
 }
 
 // Everything a feature sample needs, set up once per frame (src/render/ray_marcher.cpp).
@@ -69,27 +76,27 @@ struct Context {
     const Rgba* shadow_corr[2] = {};  // step_corrected_lut(shadows.step)
     ValueToLut map;
     bool two_tfs = false;
-    HalfSpace split;                  // clip plane 0 when two_tfs
-    const HalfSpace* clips = nullptr; // the clipping half-spaces (plane 0 excluded when two_tfs)
+    HalfSpace split;                   // clip plane 0 when two_tfs
+    const HalfSpace* clips = nullptr;  // the clipping half-spaces (plane 0 excluded when two_tfs)
     int n_clips = 0;
     float crop_lo[3] = {}, crop_hi[3] = {};  // index space
     float step = 0.5f, dt = 0, dts = 0, ert = kNoEarlyTermination;
     Vec3f sp{1, 1, 1}, inv_sp{1, 1, 1};
-    bool nearest = false;             // Interpolation::Nearest: value() reads the nearest voxel
+    bool nearest = false;  // Interpolation::Nearest: value() reads the nearest voxel
     bool need_gradient = false;
-    const float* grad[3] = {};        // precomputed world gradient, or null: on the fly
-    const float* light = nullptr;     // light volume (transmittance), or null
+    const float* grad[3] = {};     // precomputed world gradient, or null: on the fly
+    const float* light = nullptr;  // light volume (transmittance), or null
     int light_dims[3] = {0, 0, 0};
     float inv_stride = 1.f;
-    Vec3f light_dir{0, 0, 1};         // directional: unit vector to the light
-    Vec3f spot_axis{0, 0, -1};        // spot: unit vector from the light to its target
+    Vec3f light_dir{0, 0, 1};   // directional: unit vector to the light
+    Vec3f spot_axis{0, 0, -1};  // spot: unit vector from the light to its target
     int threads = 0;
 
     bool kept(float x, float y, float z) const {
         for (int i = 0; i < n_clips; ++i)
             if (!clips[i].inside(x, y, z)) return false;
-        if (f->crop && !(x >= crop_lo[0] && x <= crop_hi[0] && y >= crop_lo[1] &&
-                         y <= crop_hi[1] && z >= crop_lo[2] && z <= crop_hi[2]))
+        if (f->crop && !(x >= crop_lo[0] && x <= crop_hi[0] && y >= crop_lo[1] && y <= crop_hi[1] &&
+                         z >= crop_lo[2] && z <= crop_hi[2]))
             return false;
         return true;
     }
@@ -117,7 +124,8 @@ inline float value(const Context& c, const kernel::Grid<T, Index>& g, float x, f
 // gradient of the voxel the sample reads (the point moved to that voxel: central differences of
 // voxels, as VTK's nearest mode shades with per-voxel normals).
 template <class T, class Index>
-inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x, float y, float z) {
+inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x, float y,
+                      float z) {
     if (c.nearest) {
         x = float(int(std::clamp(x, 0.f, g.hi_x) + 0.5f));
         y = float(int(std::clamp(y, 0.f, g.hi_y) + 0.5f));
@@ -183,8 +191,12 @@ inline void light_at(const Context& c, Vec3f pw, Vec3f view, Vec3f& l, float& li
     li = L.intensity;
     dist = INFINITY;
     switch (L.kind) {
-        case LightKind::Head: l = view; break;
-        case LightKind::Directional: l = c.light_dir; break;
+        case LightKind::Head:
+            l = view;
+            break;
+        case LightKind::Directional:
+            l = c.light_dir;
+            break;
         case LightKind::Spot: {
             const Vec3f d = L.position - pw;
             dist = length(d);
@@ -271,8 +283,9 @@ inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g,
                     else
                         li *= transmittance(c, g, accel, x, y, z, l, dist, shadow_n);
                 }
-                rgb = f.shading == ShadingModel::Phong ? shading::phong(f.phong, rgb, nrm, l, view, li)
-                                                       : shading::pbr(f.pbr, rgb, nrm, l, view, li);
+                rgb = f.shading == ShadingModel::Phong
+                          ? shading::phong(f.phong, rgb, nrm, l, view, li)
+                          : shading::pbr(f.pbr, rgb, nrm, l, view, li);
             }
         }
         if (f.shading == ShadingModel::None && f.shadows.enabled) {
@@ -334,7 +347,7 @@ struct ShadeOps;
 #if LACUNA_SIMD_X86 && defined(__SSE4_1__)
 template <>
 struct ShadeOps<4> {
-    static constexpr bool kShades = false;  // scalar shading (phong_h, pbr_h)
+    static constexpr bool kShades = false;             // scalar shading (phong_h, pbr_h)
     static constexpr int kLatticeLanes = kShadeBatch;  // samples() takes half a lattice batch
     static void phong(const simd::PhongLanes&, const simd::ShadeLight&, const float*, const float*,
                       const float*, float*, float*, float*, int) {}
@@ -343,17 +356,20 @@ struct ShadeOps<4> {
     // The first n of 8 lattice samples (four at a time); returns the opacity mask.
     template <class T>
     static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
-                            const int32_t* k, float* x, float* y, float* z, float* v,
-                            int32_t* e, int n) {
+                            const int32_t* k, float* x, float* y, float* z, float* v, int32_t* e,
+                            int n) {
         unsigned mask = unsigned(simd::samples4(g, r, d, k, x, y, z, v, e));
-        if (n > 4) mask |= unsigned(simd::samples4(g, r, d, k + 4, x + 4, y + 4, z + 4, v + 4, e + 4)) << 4;
+        if (n > 4)
+            mask |= unsigned(simd::samples4(g, r, d, k + 4, x + 4, y + 4, z + 4, v + 4, e + 4))
+                    << 4;
         return mask;
     }
     // Gradients of the first n positions (four at a time).
     template <class T>
     static void gradients(const simd::ShadeGrid& g, const T* d, const float* x, const float* y,
                           const float* z, float* gx, float* gy, float* gz, int n) {
-        for (int l = 0; l < n; l += 4) simd::gradients4(g, d, x + l, y + l, z + l, gx + l, gy + l, gz + l);
+        for (int l = 0; l < n; l += 4)
+            simd::gradients4(g, d, x + l, y + l, z + l, gx + l, gy + l, gz + l);
     }
     static void volume_gradients(const simd::ShadeGrid& g, const float* const grad[3],
                                  const float* x, const float* y, const float* z, float* gx,
@@ -378,8 +394,8 @@ struct ShadeOps<8> {
     }
     template <class T>
     static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
-                            const int32_t* k, float* x, float* y, float* z, float* v,
-                            int32_t* e, int) {
+                            const int32_t* k, float* x, float* y, float* z, float* v, int32_t* e,
+                            int) {
         return unsigned(simd::samples8(g, r, d, k, x, y, z, v, e));
     }
     template <class T>
@@ -399,8 +415,8 @@ struct ShadeOps<16> : ShadeOps<8> {
     static constexpr int kLatticeLanes = kLatticeBatch;
     template <class T>
     static unsigned samples(const simd::ShadeGrid& g, const simd::ShadeRay& r, const T* d,
-                            const int32_t* k, float* x, float* y, float* z, float* v,
-                            int32_t* e, int) {
+                            const int32_t* k, float* x, float* y, float* z, float* v, int32_t* e,
+                            int) {
         return unsigned(simd::samples16(g, r, d, k, x, y, z, v, e));
     }
 };
@@ -420,7 +436,7 @@ inline simd::ShadeGrid shade_grid(const Context& c, const int dims[3]) {
 
 template <class T, class Ops>
 class ShadedStream {
-public:
+  public:
     ShadedStream(const Context& c, const T* data, const simd::ShadeGrid& sg,
                  const kernel::IndexRay& r, Vec3f view, float t_base, kernel::Accum& acc)
         : m_c(c),
@@ -437,14 +453,17 @@ public:
             m_l = L.kind == LightKind::Head ? view : c.light_dir;
             m_li = L.intensity;
             m_h_ok = shading::half_vector(m_l, view, m_h);
-            m_lanes_light = {{m_l.x, m_l.y, m_l.z}, {view.x, view.y, view.z}, {m_h.x, m_h.y, m_h.z},
-                             m_h_ok, m_li};
+            m_lanes_light = {{m_l.x, m_l.y, m_l.z},
+                             {view.x, view.y, view.z},
+                             {m_h.x, m_h.y, m_h.z},
+                             m_h_ok,
+                             m_li};
         }
         m_plain = !c.two_tfs && c.n_clips == 0 && !c.f->crop;
         // Whole batches shaded in lanes: a fixed light, and for PBR a half vector.
-        m_lane_shading = Ops::kShades && c.need_gradient && m_fixed_light &&
-                         (c.f->shading == ShadingModel::Phong ||
-                          (c.f->shading == ShadingModel::Pbr && m_h_ok));
+        m_lane_shading =
+            Ops::kShades && c.need_gradient && m_fixed_light &&
+            (c.f->shading == ShadingModel::Phong || (c.f->shading == ShadingModel::Pbr && m_h_ok));
     }
 
     // Queues the samples [kb, ke); false once the ray is opaque.
@@ -469,7 +488,7 @@ public:
     }
     uint32_t samples() const { return m_n; }
 
-private:
+  private:
     // The m_m queued lattice samples (composite_ray's steps 1, 2 and the opacity chain of 4).
     void flush_lattice() {
         const Context& c = m_c;
@@ -478,7 +497,8 @@ private:
         for (int l = m; l < kLatticeBatch; ++l) m_k[l] = m_k[m - 1];  // padding
         alignas(32) float x[kLatticeBatch], y[kLatticeBatch], z[kLatticeBatch], v[kLatticeBatch];
         alignas(32) int32_t e[kLatticeBatch];  // c.map(v), in lanes
-        unsigned visible = Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, e, std::min(m, kShadeBatch));
+        unsigned visible =
+            Ops::samples(m_sg, m_sr, m_data, m_k, x, y, z, v, e, std::min(m, kShadeBatch));
         if (Ops::kLatticeLanes < kLatticeBatch && m > kShadeBatch)
             visible |= Ops::samples(m_sg, m_sr, m_data, m_k + kShadeBatch, x + kShadeBatch,
                                     y + kShadeBatch, z + kShadeBatch, v + kShadeBatch,
@@ -593,7 +613,7 @@ private:
     const simd::ShadeGrid& m_sg;
     simd::ShadeRay m_sr;
     Vec3f m_view;
-    kernel::Accum& m_acc;   // r, g, b; a is m_alpha until finish()
+    kernel::Accum& m_acc;  // r, g, b; a is m_alpha until finish()
     float m_alpha;
     bool m_fixed_light = false, m_h_ok = false, m_done = false, m_lane_shading = false;
     bool m_plain = false;  // no clip plane, crop box or second TF
@@ -629,7 +649,10 @@ inline uint32_t extreme_ray(const Context& c, const kernel::Grid<T, Index>& g, C
         if (maximum ? e > cur : e < cur) {
             cur = e;
             cur_side = c.side(x, y, z);
-            if (maximum) lo = cur + 1; else hi = cur - 1;
+            if (maximum)
+                lo = cur + 1;
+            else
+                hi = cur - 1;
         }
         return maximum ? cur < last : cur > 0;  // nothing can beat the end of the table
     });
@@ -644,7 +667,8 @@ inline uint32_t extreme_ray(const Context& c, const kernel::Grid<T, Index>& g, C
 // Average: the TF at the mean value of the samples with non-zero TF opacity (on their side).
 template <class T, class Index, class Cursor>
 inline uint32_t average_ray(const Context& c, const kernel::Grid<T, Index>& g, Cursor& cursor,
-                            const kernel::IndexRay& r, float t_base, int k_end, kernel::Accum& acc) {
+                            const kernel::IndexRay& r, float t_base, int k_end,
+                            kernel::Accum& acc) {
     float sum = 0.f;
     uint32_t count = 0, n = 0;
     for_each_sample(cursor, t_base, c.dt, k_end, [&](int k) {
@@ -683,8 +707,10 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
     // The eight-lane paths set rays up eight pixels at a time (simd::setup_rays8: the operations
     // of Camera::generate, index_ray and intersect_box, lane by lane).
     constexpr bool kBatchSetup = [] {
-        if constexpr (std::is_void_v<Ops>) return false;
-        else return Ops::kShades;
+        if constexpr (std::is_void_v<Ops>)
+            return false;
+        else
+            return Ops::kShades;
     }();
     [[maybe_unused]] const simd::CameraView cv = camera_view(cam);
     [[maybe_unused]] const float isp[3] = {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z};
@@ -699,7 +725,8 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                 const int i = (px - x0) & 7;
                 if (i == 0) {
                     alignas(32) float bx[8], by[8];
-                    for (int q = 0; q < 8; ++q) bx[q] = float(std::min(px + q, x1 - 1)), by[q] = float(py);
+                    for (int q = 0; q < 8; ++q)
+                        bx[q] = float(std::min(px + q, x1 - 1)), by[q] = float(py);
                     simd::setup_rays8(cv, bx, by, isp, hi, rb);
                 }
                 r = {rb.ox[i], rb.oy[i], rb.oz[i], rb.dx[i], rb.dy[i], rb.dz[i]};
@@ -727,7 +754,8 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                     if constexpr (HasEntryWindow<S>) {
                         if (same_map(accel.value_map(), c.map)) {
                             const EntryWindowView<S> view_s{&accel, &lo, &hi_e};
-                            RegionCursor<EntryWindowView<S>> cursor(view_s, cr, t_near, t_far, c.dt, chunk);
+                            RegionCursor<EntryWindowView<S>> cursor(view_s, cr, t_near, t_far, c.dt,
+                                                                    chunk);
                             n = extreme_ray(c, g, cursor, r, t_base, k_end, maximum, lo, hi_e, acc);
                             done = true;
                         }
@@ -738,8 +766,9 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                         n = extreme_ray(c, g, cursor, r, t_base, k_end, maximum, lo, hi_e, acc);
                     }
                 } else {
-                    typename S::Cursor cursor(accel, cr, t_near, t_far, c.dt,
-                                              f.blend == BlendMode::Composite && c.ert < 1.f ? chunk : 0.f);
+                    typename S::Cursor cursor(
+                        accel, cr, t_near, t_far, c.dt,
+                        f.blend == BlendMode::Composite && c.ert < 1.f ? chunk : 0.f);
                     if (f.blend == BlendMode::Average) {
                         n = average_ray(c, g, cursor, r, t_base, k_end, acc);
                     } else if constexpr (!std::is_void_v<Ops>) {
@@ -749,7 +778,8 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                         stream.finish();
                         n = stream.samples();
                     } else {
-                        n = composite_ray(c, g, accel, cursor, r, view, t_base, k_end, acc, counts.shadow);
+                        n = composite_ray(c, g, accel, cursor, r, view, t_base, k_end, acc,
+                                          counts.shadow);
                     }
                 }
             }
@@ -775,9 +805,9 @@ inline bool lanes_shade(const Context& c) {
 #if LACUNA_SIMD_X86
 template <class T>
 class ShadedLanesPolicy {
-public:
-    ShadedLanesPolicy(const Context& c, const simd::ShadeFrame& sf, const T* data, RenderResult& out,
-                      const RenderOptions& opt)
+  public:
+    ShadedLanesPolicy(const Context& c, const simd::ShadeFrame& sf, const T* data,
+                      RenderResult& out, const RenderOptions& opt)
         : m_c(c), m_sf(sf), m_data(data), m_out(out), m_opt(opt), m_empty(empty_pixel_word(opt)) {
         for (int i = 0; i < simd::kShadeRecords; ++i) m_free[i] = simd::kShadeRecords - 1 - i;
         m_nfree = simd::kShadeRecords;
@@ -834,10 +864,10 @@ public:
         poll();
     }
 
-private:
+  private:
     void write(int i) {
-        write_pixel(m_out, m_opt, m_x[i], m_y[i], kernel::Accum{m_R.r[i], m_R.g[i], m_R.b[i], m_a[i]},
-                    m_n[i]);
+        write_pixel(m_out, m_opt, m_x[i], m_y[i],
+                    kernel::Accum{m_R.r[i], m_R.g[i], m_R.b[i], m_a[i]}, m_n[i]);
         m_free[m_nfree++] = i;
     }
     const Context& m_c;
@@ -861,10 +891,11 @@ private:
 // One tile of shaded rays in lanes, leaping through the refined `grid` (leap_map() set).
 // `corr_z`: the step-corrected LUT with a zero entry appended.
 template <class T>
-void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Volume& vol, const T* data,
-                              const simd::ShadeFrame& sf, const std::vector<Rgba>& corr_z,
-                              const Camera& cam, const RenderOptions& opt, int x0, int y0, int x1,
-                              int y1, RenderResult& out, Counts& counts) {
+void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Volume& vol,
+                              const T* data, const simd::ShadeFrame& sf,
+                              const std::vector<Rgba>& corr_z, const Camera& cam,
+                              const RenderOptions& opt, int x0, int y0, int x1, int y1,
+                              RenderResult& out, Counts& counts) {
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
     simd::LaneGrid lg = lane_grid(g, c.dt, c.map, corr_z.size(), c.ert);
     set_leap(lg, grid);
@@ -874,20 +905,22 @@ void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Vol
     // sixteen lanes.
     static const NoAccel kWholeRay;
     if (simd::active_isa() == simd::Isa::Avx512) {
-        schedule_tile_lanes<32>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
-                                counts.samples, counts.rays, [&](simd::Lanes& L, auto& refill) {
-                                    simd::march_shaded_lanes16<T, std::remove_reference_t<decltype(refill)>>(
-                                        L, lg, data, lut, sf, policy.queue(), policy.records(),
-                                        policy.lane_records(), refill);
-                                });
+        schedule_tile_lanes<32>(
+            kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy, counts.samples,
+            counts.rays, [&](simd::Lanes& L, auto& refill) {
+                simd::march_shaded_lanes16<T, std::remove_reference_t<decltype(refill)>>(
+                    L, lg, data, lut, sf, policy.queue(), policy.records(), policy.lane_records(),
+                    refill);
+            });
         return;
     }
-    schedule_tile_lanes<8>(kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy,
-                           counts.samples, counts.rays, [&](simd::Lanes& L, auto& refill) {
-                               simd::march_shaded_lanes8<T, std::remove_reference_t<decltype(refill)>, true>(
-                                   L, lg, data, lut, sf, policy.queue(), policy.records(),
-                                   policy.lane_records(), refill);
-                           });
+    schedule_tile_lanes<8>(
+        kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy, counts.samples, counts.rays,
+        [&](simd::Lanes& L, auto& refill) {
+            simd::march_shaded_lanes8<T, std::remove_reference_t<decltype(refill)>, true>(
+                L, lg, data, lut, sf, policy.queue(), policy.records(), policy.lane_records(),
+                refill);
+        });
 }
 #endif
 

@@ -17,7 +17,9 @@ namespace lacuna {
 
 namespace {
 
-bool finite3(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite3(Vec3f v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 }  // namespace
 
@@ -30,12 +32,12 @@ void validate_features(const FeatureOptions& f) {
     if (!(p.ambient >= 0 && p.diffuse >= 0 && p.specular >= 0 && p.power >= 0) ||
         !std::isfinite(p.ambient + p.diffuse + p.specular + p.power))
         fail("features.phong", "expected finite ambient, diffuse, specular, power >= 0");
-    if (!(f.pbr.roughness > 0 && f.pbr.roughness <= 1) || !(f.pbr.metallic >= 0 && f.pbr.metallic <= 1) ||
+    if (!(f.pbr.roughness > 0 && f.pbr.roughness <= 1) ||
+        !(f.pbr.metallic >= 0 && f.pbr.metallic <= 1) ||
         !(f.pbr.ambient >= 0 && std::isfinite(f.pbr.ambient)))
         fail("features.pbr", "expected roughness in (0,1], metallic in [0,1], ambient >= 0");
     const GradientOpacity& go = f.gradient_opacity;
-    if (go.enabled && go.points.empty() &&
-        !(go.lo >= 0 && go.lo <= go.hi && std::isfinite(go.hi)))
+    if (go.enabled && go.points.empty() && !(go.lo >= 0 && go.lo <= go.hi && std::isfinite(go.hi)))
         fail("features.gradient_opacity", "expected 0 <= LO <= HI");
     if (go.enabled)
         for (size_t i = 0; i < go.points.size(); ++i) {
@@ -46,7 +48,8 @@ void validate_features(const FeatureOptions& f) {
             if (i > 0 && q.x < go.points[i - 1].x)
                 fail("features.gradient_opacity.points", "expected points sorted by x");
             if (i > 1 && q.x == go.points[i - 2].x)
-                fail("features.gradient_opacity.points", "expected at most two points per x (a step)");
+                fail("features.gradient_opacity.points",
+                     "expected at most two points per x (a step)");
         }
     const Light& l = f.light;
     if (!(l.intensity >= 0 && std::isfinite(l.intensity)))
@@ -56,7 +59,8 @@ void validate_features(const FeatureOptions& f) {
     if (l.kind == LightKind::Spot &&
         (!finite3(l.position) || !finite3(l.target) || !(length(l.target - l.position) > 0) ||
          !(l.cone_deg > 0 && l.cone_deg < 90)))
-        fail("features.light", "expected position != target and a cone half-angle in (0, 90) degrees");
+        fail("features.light",
+             "expected position != target and a cone half-angle in (0, 90) degrees");
     if (!(f.shadows.step > 0 && f.shadows.step <= 64))
         fail("features.shadows.step", "expected 0 < step <= 64");
     if (f.shadows.light_volume_stride < 1 || f.shadows.light_volume_stride > 64)
@@ -64,8 +68,9 @@ void validate_features(const FeatureOptions& f) {
     for (const ClipPlane& c : f.clip_planes)
         if (!finite3(c.normal) || !(length(c.normal) > 0) || !std::isfinite(c.d))
             fail("features.clip_planes", "expected a finite non-zero normal and a finite offset");
-    if (f.crop && !(finite3(f.crop_box.lo) && finite3(f.crop_box.hi) && f.crop_box.lo.x <= f.crop_box.hi.x &&
-                    f.crop_box.lo.y <= f.crop_box.hi.y && f.crop_box.lo.z <= f.crop_box.hi.z))
+    if (f.crop &&
+        !(finite3(f.crop_box.lo) && finite3(f.crop_box.hi) && f.crop_box.lo.x <= f.crop_box.hi.x &&
+          f.crop_box.lo.y <= f.crop_box.hi.y && f.crop_box.lo.z <= f.crop_box.hi.z))
         fail("features.crop_box", "expected x0 <= x1, y0 <= y1, z0 <= z1");
 }
 
@@ -76,13 +81,15 @@ template <class T>
 void gradient_volume(const Volume& v, const T* data, std::vector<float> out[3], int threads) {
     const Vec3i d = v.dims();
     for (int a = 0; a < 3; ++a) out[a].assign(v.voxel_count(), 0.f);
-    const float inv[3] = {float(1.0 / v.spacing.x), float(1.0 / v.spacing.y), float(1.0 / v.spacing.z)};
+    const float inv[3] = {float(1.0 / v.spacing.x), float(1.0 / v.spacing.y),
+                          float(1.0 / v.spacing.z)};
     parallel_for(size_t(d.z), threads, [&](size_t z0, size_t z1) {
         for (int k = int(z0); k < int(z1); ++k)
             for (int j = 0; j < d.y; ++j)
                 for (int i = 0; i < d.x; ++i) {
                     auto at = [&](int x, int y, int z) {
-                        x = std::clamp(x, 0, d.x - 1), y = std::clamp(y, 0, d.y - 1), z = std::clamp(z, 0, d.z - 1);
+                        x = std::clamp(x, 0, d.x - 1), y = std::clamp(y, 0, d.y - 1),
+                        z = std::clamp(z, 0, d.z - 1);
                         return float(data[v.index(x, y, z)]);
                     };
                     const size_t idx = v.index(i, j, k);
@@ -104,7 +111,8 @@ std::string light_key(const FeatureOptions& f, Vec3f l_fixed, uint64_t tf_versio
     k += to_string(f.light.kind) + ":";
     for (Vec3f v : {l_fixed, f.light.position, f.light.target}) add(v.x), add(v.y), add(v.z);
     add(f.light.cone_deg), add(f.shadows.step), add(ert), add(float(f.shadows.light_volume_stride));
-    for (const ClipPlane& c : f.clip_planes) add(c.normal.x), add(c.normal.y), add(c.normal.z), add(c.d);
+    for (const ClipPlane& c : f.clip_planes)
+        add(c.normal.x), add(c.normal.y), add(c.normal.z), add(c.d);
     if (f.crop)
         for (Vec3f v : {f.crop_box.lo, f.crop_box.hi}) add(v.x), add(v.y), add(v.z);
     return k + "tf" + std::to_string(tf_version);
@@ -167,7 +175,8 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
         }
     const bool composite = f.blend == BlendMode::Composite;
     c.need_gradient = composite && (f.shading != ShadingModel::None || f.gradient_opacity.enabled);
-    c.light_dir = f.light.kind == LightKind::Directional ? normalize(f.light.direction) : Vec3f{0, 0, 1};
+    c.light_dir =
+        f.light.kind == LightKind::Directional ? normalize(f.light.direction) : Vec3f{0, 0, 1};
     if (f.light.kind == LightKind::Spot) c.spot_axis = normalize(f.light.target - f.light.position);
     const bool shadows = composite && f.shadows.enabled;
 
@@ -198,7 +207,8 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
         visit_accel(m_accel ? *m_accel : kNone, [&](const auto& acc) {
             // 4. The light volume, when the light, TF or clipping changed since it was made.
             if (shadows && f.shadows.light_volume) {
-                const Vec3f l_fixed = f.light.kind == LightKind::Head ? -cam.forward() : c.light_dir;
+                const Vec3f l_fixed =
+                    f.light.kind == LightKind::Head ? -cam.forward() : c.light_dir;
                 const std::string key = light_key(f, l_fixed, m_tf_version, opt.ert);
                 const int stride = f.shadows.light_volume_stride;
                 int* m = m_cache->light_dims;
@@ -213,26 +223,27 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
                                                 m_cache->light.data(), shadow);
                     m_cache->light_key = key;
                     out.stats.light_volume_seconds =
-                        std::chrono::duration<double>(std::chrono::steady_clock::now() - l0).count();
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - l0)
+                            .count();
                 }
                 for (int a = 0; a < 3; ++a) c.light_dims[a] = m[a];
                 c.light = m_cache->light.data();
                 c.inv_stride = 1.f / float(stride);
                 out.stats.light_volume_bytes = m_cache->light.size() * sizeof(float);
             }
-            // 5. The frame: composite rays without shadows or gradient opacity on the batched SIMD path of the
-            // active ISA (int32 offsets: grids under 2^31 voxels), the rest one sample at a
-            // time (feature::composite_ray, the reference; also the scalar ISA path).
+            // 5. The frame: composite rays without shadows or gradient opacity on the batched SIMD
+            // path of the active ISA (int32 offsets: grids under 2^31 voxels), the rest one sample
+            // at a time (feature::composite_ray, the reference; also the scalar ISA path).
             const int dims[3] = {d.x, d.y, d.z};
             simd::ShadeGrid sg = feature::shade_grid(c, dims);
             // The structure's visible-cell mask (refined grids), for the plain batched case: one
             // TF (the structure's), no clip planes or crop box, trilinear samples.
             if constexpr (requires { acc.cell_mask(); })
-                if (!c.nearest && !c.two_tfs && c.n_clips == 0 && !f.crop) sg.cell_mask = acc.cell_mask();
+                if (!c.nearest && !c.two_tfs && c.n_clips == 0 && !f.crop)
+                    sg.cell_mask = acc.cell_mask();
             // Nearest sampling runs the reference too (one path for every ISA, so still exact).
             const bool batched = composite && !f.shadows.enabled && !f.gradient_opacity.enabled &&
-                                 !c.nearest &&
-                                 m_volume.voxel_count() < (size_t(1) << 31);
+                                 !c.nearest && m_volume.voxel_count() < (size_t(1) << 31);
             auto frame = [&](auto ops) {
                 using Ops = typename decltype(ops)::type;
                 parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
@@ -251,26 +262,27 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             // lanes, leaping (simd::march_shaded_lanes8; tiles too large for the scheduler take
             // ShadedStream).
             if constexpr (std::is_same_v<std::decay_t<decltype(acc)>, BrickGrid>) {
-                if ((isa == simd::Isa::Avx2 || isa == simd::Isa::Avx512) && feature::lanes_shade(c) &&
-                    acc.leap_map()) {
+                if ((isa == simd::Isa::Avx2 || isa == simd::Isa::Avx512) &&
+                    feature::lanes_shade(c) && acc.leap_map()) {
                     std::vector<Rgba> corr_z = corr0;
                     corr_z.push_back(Rgba{});  // the zero entry idle lanes composite
                     simd::ShadeGrid sg_lanes = sg;
                     sg_lanes.cell_mask = nullptr;
-                    const simd::ShadeFrame sf{sg_lanes,
-                                              &c.raw[0][0].r,
-                                              c.grad[0] ? c.grad : nullptr,
-                                              {f.phong.ambient, f.phong.diffuse, f.phong.specular, f.phong.power},
-                                              f.light.intensity,
-                                              f.light.kind == LightKind::Head,
-                                              {c.light_dir.x, c.light_dir.y, c.light_dir.z}};
+                    const simd::ShadeFrame sf{
+                        sg_lanes,
+                        &c.raw[0][0].r,
+                        c.grad[0] ? c.grad : nullptr,
+                        {f.phong.ambient, f.phong.diffuse, f.phong.specular, f.phong.power},
+                        f.light.intensity,
+                        f.light.kind == LightKind::Head,
+                        {c.light_dir.x, c.light_dir.y, c.light_dir.z}};
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
                                            feature::Counts n;
                                            if ((x1 - x0) * (y1 - y0) <= kMaxTilePixels)
-                                               feature::render_tile_shaded_lanes(c, acc, m_volume, data, sf,
-                                                                                 corr_z, cam, opt, x0, y0,
-                                                                                 x1, y1, out, n);
+                                               feature::render_tile_shaded_lanes(
+                                                   c, acc, m_volume, data, sf, corr_z, cam, opt, x0,
+                                                   y0, x1, y1, out, n);
                                            else
                                                feature::render_tile<feature::ShadeOps<8>>(
                                                    c, acc, g, sg, cam, opt, x0, y0, x1, y1, out, n);
@@ -289,7 +301,8 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             frame(std::type_identity<void>{});
         });
     });
-    out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out.stats.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.stats.cpu_seconds = process_cpu_seconds() - cpu0;
     out.stats.samples = samples;
     out.stats.rays = rays;

@@ -201,7 +201,8 @@ struct CompositePolicy {
     float t_base(int, int, float t_near) const { return t_near; }
     void begin(int, int, int, Vec3f, int) {}
     void finish(int l, int x, int y, const simd::Lanes& L) {
-        write_pixel(out, opt, x, y, kernel::Accum{L.r[l], L.g[l], L.b[l], L.a[l]}, uint32_t(L.n[l]));
+        write_pixel(out, opt, x, y, kernel::Accum{L.r[l], L.g[l], L.b[l], L.a[l]},
+                    uint32_t(L.n[l]));
     }
     void empty(int x, int y) { write_empty_pixel(out, opt, empty_word, x, y); }
     void poll() {}

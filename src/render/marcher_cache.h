@@ -15,7 +15,7 @@ struct RayMarcher::Cache {
     std::vector<float> grad[3];  // world gradient per voxel (GradientSource::Precomputed)
     std::vector<float> light;    // transmittance toward the light (ShadowOptions::light_volume)
     int light_dims[3] = {0, 0, 0};
-    std::string light_key;       // the light, TF and clipping the light volume was made for
+    std::string light_key;  // the light, TF and clipping the light volume was made for
 };
 
 }  // namespace lacuna

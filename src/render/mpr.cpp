@@ -63,8 +63,8 @@ WorldToIndex world_to_index(const Volume& v) {
 
 bool inside_box(Vec3d p, Vec3i dims) {
     const double e = kInsideTolerance;
-    return p.x >= -e && p.y >= -e && p.z >= -e && p.x <= dims.x - 1 + e &&
-           p.y <= dims.y - 1 + e && p.z <= dims.z - 1 + e;
+    return p.x >= -e && p.y >= -e && p.z >= -e && p.x <= dims.x - 1 + e && p.y <= dims.y - 1 + e &&
+           p.z <= dims.z - 1 + e;
 }
 
 // Calls f(c, r, index) for every pixel of g, in tiles on the project's threads; index is the
@@ -96,8 +96,8 @@ std::string to_string(SlicePlane p) {
 SlicePlane parse_slice_plane(const std::string& name, const std::string& where) {
     for (SlicePlane p : {SlicePlane::Axial, SlicePlane::Coronal, SlicePlane::Sagittal})
         if (name == to_string(p)) return p;
-    throw Error(where, "plane", "unknown '" + name.substr(0, 40) +
-                                    "'; expected axial, coronal or sagittal");
+    throw Error(where, "plane",
+                "unknown '" + name.substr(0, 40) + "'; expected axial, coronal or sagittal");
 }
 
 std::string to_string(const SliceGeometry& g) {
@@ -113,8 +113,7 @@ SliceGeometry slice_geometry(const Volume& v, SlicePlane plane, Vec3d point, con
     if (p == 0) p = std::min({v.spacing.x, v.spacing.y, v.spacing.z});
     if (!std::isfinite(p) || p <= 0)
         throw Error(where, "pixel_mm", "expected a finite positive size, got " + std::to_string(p));
-    if (o.max_size < 0)
-        throw Error(where, "max_size", "expected 0 (no cap) or a positive size");
+    if (o.max_size < 0) throw Error(where, "max_size", "expected 0 (no cap) or a positive size");
     const PlaneAxes ax = plane_axes(plane);
     // 1. The sampled box's 8 world corners projected on screen right and screen up.
     const Affine a = index_to_world(v);
@@ -201,7 +200,8 @@ std::vector<int32_t> sample_labels(const Volume& labels, const SliceGeometry& g,
 
 Image window_level(const Slice& s, double window, double level, const std::string& where) {
     if (!std::isfinite(window) || window <= 0)
-        throw Error(where, "window", "expected a finite positive width, got " + std::to_string(window));
+        throw Error(where, "window",
+                    "expected a finite positive width, got " + std::to_string(window));
     if (!std::isfinite(level))
         throw Error(where, "level", "expected a finite number, got " + std::to_string(level));
     Image img(s.geometry.width, s.geometry.height);
@@ -209,7 +209,8 @@ Image window_level(const Slice& s, double window, double level, const std::strin
     for (size_t i = 0; i < s.values.size(); ++i) {
         const float x = s.values[i];
         uint8_t grey = 0;
-        if (!std::isnan(x)) grey = uint8_t(std::lround(std::clamp((x - lo) / window, 0.0, 1.0) * 255));
+        if (!std::isnan(x))
+            grey = uint8_t(std::lround(std::clamp((x - lo) / window, 0.0, 1.0) * 255));
         uint8_t* px = &img.rgba[i * 4];
         px[0] = px[1] = px[2] = grey;
         px[3] = 255;
@@ -245,8 +246,11 @@ ProbeResult probe(const Volume& v, Vec3d world, Interpolation interp, const Volu
     out.voxel_value = out.value;
     if (out.inside) {
         const Vec3i d = v.dims();
-        auto round_in = [](double x, int n) { return std::clamp(int(std::floor(x + 0.5)), 0, n - 1); };
-        out.voxel = {round_in(out.index.x, d.x), round_in(out.index.y, d.y), round_in(out.index.z, d.z)};
+        auto round_in = [](double x, int n) {
+            return std::clamp(int(std::floor(x + 0.5)), 0, n - 1);
+        };
+        out.voxel = {round_in(out.index.x, d.x), round_in(out.index.y, d.y),
+                     round_in(out.index.z, d.z)};
         out.voxel_value = v.value(out.voxel.x, out.voxel.y, out.voxel.z);
         out.value = visit_voxels(v, [&](const auto* data) {
             const auto grid = kernel::make_grid<int64_t>(data, d);

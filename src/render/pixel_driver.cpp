@@ -17,7 +17,8 @@ static inline uint32_t word_of(const Vec3f& background, const kernel::Accum& acc
 #if defined(__SSE4_1__)
     // (the same operations, three channels at once and without branches)
     const __m128 v = _mm_mul_ps(
-        _mm_min_ps(_mm_max_ps(_mm_setr_ps(rgb[0], rgb[1], rgb[2], 1.f), _mm_setzero_ps()), _mm_set1_ps(1.f)),
+        _mm_min_ps(_mm_max_ps(_mm_setr_ps(rgb[0], rgb[1], rgb[2], 1.f), _mm_setzero_ps()),
+                   _mm_set1_ps(1.f)),
         _mm_set1_ps(255.f));
     const __m128i t = _mm_cvttps_epi32(v);
     const __m128i r = _mm_sub_epi32(

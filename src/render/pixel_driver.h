@@ -43,9 +43,10 @@ inline kernel::IndexRay index_ray(const Ray& wr, Vec3f inv_sp) {
 // The camera as the batched ray set-up reads it (core/simd_lanes.h setup_rays8).
 inline simd::CameraView camera_view(const Camera& c) {
     const Vec3f e = c.eye(), f = c.forward(), r = c.right(), u = c.up();
-    return simd::CameraView{{e.x, e.y, e.z}, {f.x, f.y, f.z}, {r.x, r.y, r.z}, {u.x, u.y, u.z},
-                            c.half_height(), float(c.width()), float(c.height()),
-                            c.projection() == Projection::Orthographic};
+    return simd::CameraView{{e.x, e.y, e.z},   {f.x, f.y, f.z},
+                            {r.x, r.y, r.z},   {u.x, u.y, u.z},
+                            c.half_height(),   float(c.width()),
+                            float(c.height()), c.projection() == Projection::Orthographic};
 }
 
 // Number of lattice samples t_k = t_base + (k + 0.5)*dt with t_k < t_far.
@@ -67,7 +68,7 @@ inline void lattice_run(const Segment& seg, float t_base, float inv_dt, int k, i
 }
 template <class Cursor>
 class LatticeRuns {
-public:
+  public:
     LatticeRuns(Cursor& cursor, float t_base, float dt, int k_end)
         : m_cursor(cursor), m_t_base(t_base), m_inv_dt(1.f / dt), m_end(k_end) {}
     bool next(int& kb, int& ke) {
@@ -85,7 +86,7 @@ public:
         return false;
     }
 
-private:
+  private:
     Cursor& m_cursor;
     float m_t_base, m_inv_dt;
     int m_end, m_k = 0;
@@ -127,7 +128,8 @@ void write_pixel(RenderResult& out, const RenderOptions& opt, int x, int y,
 // The pixel of a ray without samples, write_pixel(out, opt, x, y, Accum{}, 0), with its word
 // computed once per tile (empty_pixel_word(opt)): on a head half the pixels miss the volume.
 uint32_t empty_pixel_word(const RenderOptions& opt);
-inline void write_empty_pixel(RenderResult& out, const RenderOptions& opt, uint32_t word, int x, int y) {
+inline void write_empty_pixel(RenderResult& out, const RenderOptions& opt, uint32_t word, int x,
+                              int y) {
     std::memcpy(out.image.pixel(x, y), &word, 4);
     if (opt.keep_float || opt.count_samples) write_pixel(out, opt, x, y, kernel::Accum{}, 0);
 }

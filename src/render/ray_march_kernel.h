@@ -23,8 +23,8 @@ namespace lacuna::kernel {
 template <class T, class Index = int32_t>
 struct Grid {
     const T* data;
-    ptrdiff_t sy, sz;      // strides of j and k (i has stride 1)
-    float hi_x, hi_y, hi_z;  // dims - 1 (the sampled box is [0, hi])
+    ptrdiff_t sy, sz;            // strides of j and k (i has stride 1)
+    float hi_x, hi_y, hi_z;      // dims - 1 (the sampled box is [0, hi])
     int cell_x, cell_y, cell_z;  // dims - 2: largest cell index
 };
 
@@ -136,12 +136,17 @@ inline constexpr int kBatch = 8;
 // the SIMD paths run several rays per instruction instead (core/simd_lanes.h).
 template <class T, class Index, bool kNearest = false>
 class RayStream {
-public:
+  public:
     RayStream(const Grid<T, Index>& g, const IndexRay& r, float t_base, float dt, const Rgba* lut,
               ValueToLut map, float ert, Accum& acc)
-        : m_g(g), m_r(r), m_t_base(t_base), m_dt(dt), m_lut(lut), m_map(map), m_ert(ert),
-          m_acc(acc) {
-    }
+        : m_g(g),
+          m_r(r),
+          m_t_base(t_base),
+          m_dt(dt),
+          m_lut(lut),
+          m_map(map),
+          m_ert(ert),
+          m_acc(acc) {}
 
     // Queues the samples [kb, ke) (after every sample queued before); false once the ray is
     // opaque, when further samples would be discarded.
@@ -163,7 +168,7 @@ public:
     uint32_t samples() const { return m_n; }
     bool done() const { return m_done; }
 
-private:
+  private:
     // Evaluates the m_m queued samples (padding the batch), composites them; false when opaque.
     LACUNA_ALWAYS_INLINE bool flush() {
         for (int l = m_m; l < kBatch; ++l) m_k[l] = m_k[m_m - 1];
@@ -194,7 +199,6 @@ private:
         m_done = opaque;
         return !opaque;
     }
-
 
     // LUT entries of the kBatch queued samples.
     LACUNA_ALWAYS_INLINE void lut_entries(int* entry) const {

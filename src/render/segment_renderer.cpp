@@ -33,11 +33,11 @@ struct SegmentRenderer::Impl {
     // Per label: labels mode premultiplied colour and opacity per unit distance (step-corrected
     // at render time); masked mode colour and opacity factor (0 when hidden).
     std::vector<Rgba> table;
-    Impl(const Volume* i, const Volume& l, const SegmentOptions& o) : intensity(i), labels(l), opts(o) {}
+    Impl(const Volume* i, const Volume& l, const SegmentOptions& o)
+        : intensity(i), labels(l), opts(o) {}
 };
 
 namespace {
-
 
 template <class L>
 struct LabelGrid {
@@ -56,9 +56,9 @@ struct LabelGrid {
 struct Frame {
     const Camera& cam;
     const RenderOptions& opt;
-    const Rgba* lut;           // step-corrected intensity LUT (masked mode)
+    const Rgba* lut;  // step-corrected intensity LUT (masked mode)
     ValueToLut map;
-    const Rgba* table;         // per label (see Impl::table), step-corrected in labels mode
+    const Rgba* table;  // per label (see Impl::table), step-corrected in labels mode
     int table_size;
     float tint;
     bool masked;
@@ -73,8 +73,8 @@ void render_tile(const S& accel, const Volume& geom, const T* data, const L* lab
                  int x0, int y0, int x1, int y1) {
     const Vec3i d = geom.dims();
     const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, d);
-    const LabelGrid<L> lg{labels, ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
-                          d.x - 1, d.y - 1, d.z - 1};
+    const LabelGrid<L> lg{labels,  ptrdiff_t(d.x), ptrdiff_t(d.x) * ptrdiff_t(d.y),
+                          d.x - 1, d.y - 1,        d.z - 1};
     const Vec3f inv_sp = inverse_spacing(geom);
     const float dt = sample_distance(geom, f.opt.step);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
@@ -204,7 +204,8 @@ RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOption
     out.image = Image(cam.width(), cam.height());
     if (opt.count_samples) out.sample_counts.assign(size_t(cam.width()) * cam.height(), 0);
     if (opt.keep_float) out.rgba_float.assign(size_t(cam.width()) * cam.height() * 4, 0.f);
-    const std::vector<Rgba> lut = masked ? step_corrected_lut(im.lut, opt.step) : std::vector<Rgba>{};
+    const std::vector<Rgba> lut =
+        masked ? step_corrected_lut(im.lut, opt.step) : std::vector<Rgba>{};
     // Labels mode: label opacity is per unit distance, corrected for the step like a TF entry.
     std::vector<Rgba> table = im.table;
     if (!masked) {
@@ -213,9 +214,18 @@ RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOption
         table = step_corrected_lut(as_lut, opt.step);
     }
     std::atomic<uint64_t> samples{0}, rays{0};
-    const Frame f{cam, opt, lut.data(), masked ? im.lut.map() : ValueToLut{}, table.data(),
-                  int(table.size()), im.opts.tint, masked,
-                  opt.interpolation == Interpolation::Nearest, out, samples, rays};
+    const Frame f{cam,
+                  opt,
+                  lut.data(),
+                  masked ? im.lut.map() : ValueToLut{},
+                  table.data(),
+                  int(table.size()),
+                  im.opts.tint,
+                  masked,
+                  opt.interpolation == Interpolation::Nearest,
+                  out,
+                  samples,
+                  rays};
     // Labels mode samples no intensity: the label volume stands in as the (unused) grid.
     const Volume& geom = masked ? *im.intensity : im.labels;
     const auto t0 = std::chrono::steady_clock::now();
@@ -227,7 +237,8 @@ RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOption
                 auto run = [&](const auto& s) {
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
-                                           render_tile<T, L>(s, geom, data, labels, f, x0, y0, x1, y1);
+                                           render_tile<T, L>(s, geom, data, labels, f, x0, y0, x1,
+                                                             y1);
                                        });
                 };
                 if (im.octree)
@@ -239,7 +250,8 @@ RenderResult SegmentRenderer::render(const Camera& world_cam, const RenderOption
             }
         });
     });
-    out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out.stats.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.stats.samples = samples;
     out.stats.rays = rays;
     out.stats.pixels = uint64_t(cam.width()) * cam.height();

@@ -100,7 +100,8 @@ inline Vec3f pbr_h(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, 
     const float ndv = std::max(dot(n, v), 1e-4f);
     const float ndh = std::max(dot(n, h), 0.f), ldh = std::max(dot(l, h), 0.f);
     const float diffuse = li * disney_diffuse(ndv, ndl, ldh, rough) * ndl;
-    const float spec_common = li * kPi * ggx_d(ndh, alpha) * smith_joint_ggx_v(ndl, ndv, alpha) * ndl;
+    const float spec_common =
+        li * kPi * ggx_d(ndh, alpha) * smith_joint_ggx_v(ndl, ndv, alpha) * ndl;
     const float m = std::clamp(p.metallic, 0.f, 1.f);
     const float c[3] = {albedo.x, albedo.y, albedo.z};
     float out[3];
@@ -120,7 +121,8 @@ inline Vec3f pbr(const PbrParams& p, Vec3f albedo, Vec3f n, Vec3f l, Vec3f v, fl
 
 // Spot falloff: 1 inside 0.8*cone, 0 outside the cone, smoothstep between.
 inline float spot_factor(float cos_angle, float cone_deg) {
-    const float c_out = std::cos(cone_deg * kPi / 180.f), c_in = std::cos(0.8f * cone_deg * kPi / 180.f);
+    const float c_out = std::cos(cone_deg * kPi / 180.f),
+                c_in = std::cos(0.8f * cone_deg * kPi / 180.f);
     if (cos_angle <= c_out) return 0.f;
     if (cos_angle >= c_in) return 1.f;
     const float x = (cos_angle - c_out) / (c_in - c_out);

@@ -69,7 +69,8 @@ std::string to_slicer_vp_json(const TransferFunction& tf, ValueRange vis, double
     if (has_gradient) {
         TransferFunction as_value;
         as_value.domain = TfDomain::Value;
-        const std::vector<double> gx = vtk_xs(r.gradient_opacity, as_value, vis, "gradient_opacity");
+        const std::vector<double> gx =
+            vtk_xs(r.gradient_opacity, as_value, vis, "gradient_opacity");
         for (size_t i = 0; i < gx.size(); ++i) {
             json p = segment(gx[i]);
             p["y"] = double(r.gradient_opacity[i].a);
@@ -81,24 +82,24 @@ std::string to_slicer_vp_json(const TransferFunction& tf, ValueRange vis, double
         gradient.push_back(p);  // VTK's constant 1, disabled below
     }
     const TfShading shading = r.shading.value_or(TfShading{});
-    json component{
-        {"componentWeight", 1.0},
-        {"shade", r.shading.has_value()},
-        {"lighting",
-         {{"ambient", double(shading.ambient)},
-          {"diffuse", double(shading.diffuse)},
-          {"specular", double(shading.specular)},
-          {"specularPower", double(shading.specular_power)}}},
-        {"disableGradientOpacity", !has_gradient},
-        {"scalarOpacityUnitDistance", smallest_spacing > 0 ? smallest_spacing : 1.0},
-        {"scalarOpacity", {{"points", opacity}}},
-        {"gradientOpacity", {{"points", gradient}}},
-        {"rgbTransferFunction", {{"points", color}}}};
+    json component{{"componentWeight", 1.0},
+                   {"shade", r.shading.has_value()},
+                   {"lighting",
+                    {{"ambient", double(shading.ambient)},
+                     {"diffuse", double(shading.diffuse)},
+                     {"specular", double(shading.specular)},
+                     {"specularPower", double(shading.specular_power)}}},
+                   {"disableGradientOpacity", !has_gradient},
+                   {"scalarOpacityUnitDistance", smallest_spacing > 0 ? smallest_spacing : 1.0},
+                   {"scalarOpacity", {{"points", opacity}}},
+                   {"gradientOpacity", {{"points", gradient}}},
+                   {"rgbTransferFunction", {{"points", color}}}};
     json property{{"interpolationType", "linear"},
                   {"independentComponents", false},
                   {"components", json::array({component})}};
     if (!tf.name.empty()) property["name"] = tf.name;
-    if (tf.range) property["effectiveRange"] = json::array({double(tf.range->min), double(tf.range->max)});
+    if (tf.range)
+        property["effectiveRange"] = json::array({double(tf.range->min), double(tf.range->max)});
     json doc{{"@schema",
               "https://raw.githubusercontent.com/Slicer/Slicer/main/Modules/Loadable/"
               "VolumeRendering/Resources/Schema/volume-property-schema-v1.0.0.json#"},

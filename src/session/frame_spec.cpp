@@ -10,9 +10,12 @@ namespace lacuna {
 
 std::string to_string(Renderer r) {
     switch (r) {
-        case Renderer::RayMarcher: return "march";
-        case Renderer::Slicer: return "slice";
-        case Renderer::Segments: return "segments";
+        case Renderer::RayMarcher:
+            return "march";
+        case Renderer::Slicer:
+            return "slice";
+        case Renderer::Segments:
+            return "segments";
     }
     return "?";
 }
@@ -20,9 +23,13 @@ std::string to_string(Renderer r) {
 // ---- Structures (the registry: src/session/structure_registry.h) -------------------------------
 using registry::kHasOctree;
 
-std::string structure_name(const Structure& s) { return registry::entry(s).name; }
+std::string structure_name(const Structure& s) {
+    return registry::entry(s).name;
+}
 
-std::optional<AccelKind> accel_kind(const Structure& s) { return registry::entry(s).ray; }
+std::optional<AccelKind> accel_kind(const Structure& s) {
+    return registry::entry(s).ray;
+}
 
 Structure structure_of(AccelKind k, const AccelOptions& o) {
     // The alternative whose registry entry has kind k, its parameters from o (the inverse of
@@ -41,11 +48,13 @@ Structure structure_of(AccelKind k, const AccelOptions& o) {
                               std::is_same_v<T, structure::Chebyshev>)
                     v.block = o.distance_block;
                 if constexpr (std::is_same_v<T, structure::KdTree>)
-                    v = {o.kd_max_boxes, o.kd_delta, o.kd_min_volume, o.kd_min_gain, o.kd_max_depth};
+                    v = {o.kd_max_boxes, o.kd_delta, o.kd_min_volume, o.kd_min_gain,
+                         o.kd_max_depth};
                 out = v;
             }(),
             ...);
-    }(std::make_index_sequence<std::variant_size_v<Structure>>{});
+    }
+    (std::make_index_sequence<std::variant_size_v<Structure>>{});
     return out;
 }
 
@@ -98,33 +107,49 @@ std::vector<Structure> all_structures() {
     std::vector<Structure> out;
     [&]<size_t... I>(std::index_sequence<I...>) {
         (out.push_back(std::variant_alternative_t<I, Structure>{}), ...);
-    }(std::make_index_sequence<std::variant_size_v<Structure>>{});
+    }
+    (std::make_index_sequence<std::variant_size_v<Structure>>{});
     return out;
 }
 
 // ---- Capabilities -------------------------------------------------------------------------------
 std::string to_string(Feature f) {
     switch (f) {
-        case Feature::Shading: return "shading";
-        case Feature::GradientOpacity: return "gradient_opacity";
-        case Feature::Shadows: return "shadows";
-        case Feature::ClipPlanes: return "clip_planes";
-        case Feature::Crop: return "crop";
-        case Feature::Blend: return "blend";
-        case Feature::Jitter: return "jitter";
-        case Feature::TwoTfs: return "two_tfs";
-        case Feature::Nearest: return "nearest";
-        case Feature::EarlyTermination: return "early_termination";
-        case Feature::SampleCounts: return "sample_counts";
-        case Feature::Occlusion: return "occlusion";
+        case Feature::Shading:
+            return "shading";
+        case Feature::GradientOpacity:
+            return "gradient_opacity";
+        case Feature::Shadows:
+            return "shadows";
+        case Feature::ClipPlanes:
+            return "clip_planes";
+        case Feature::Crop:
+            return "crop";
+        case Feature::Blend:
+            return "blend";
+        case Feature::Jitter:
+            return "jitter";
+        case Feature::TwoTfs:
+            return "two_tfs";
+        case Feature::Nearest:
+            return "nearest";
+        case Feature::EarlyTermination:
+            return "early_termination";
+        case Feature::SampleCounts:
+            return "sample_counts";
+        case Feature::Occlusion:
+            return "occlusion";
     }
     return "?";
 }
 
 std::vector<Feature> all_features() {
-    return {Feature::Shading, Feature::GradientOpacity, Feature::Shadows,  Feature::ClipPlanes,
-            Feature::Crop,    Feature::Blend,           Feature::Jitter,   Feature::TwoTfs,
-            Feature::Nearest, Feature::EarlyTermination, Feature::SampleCounts, Feature::Occlusion};
+    return {Feature::Shading,      Feature::GradientOpacity,
+            Feature::Shadows,      Feature::ClipPlanes,
+            Feature::Crop,         Feature::Blend,
+            Feature::Jitter,       Feature::TwoTfs,
+            Feature::Nearest,      Feature::EarlyTermination,
+            Feature::SampleCounts, Feature::Occlusion};
 }
 
 bool RendererCapabilities::takes(const Structure& s) const {
@@ -159,7 +184,10 @@ const std::vector<RendererCapabilities>& capabilities() {
               Feature::Crop, Feature::Blend, Feature::Jitter, Feature::TwoTfs, Feature::Nearest,
               Feature::EarlyTermination, Feature::SampleCounts},
              {}},
-            {Renderer::Slicer, boxes, {Feature::Nearest, Feature::EarlyTermination, Feature::Occlusion}, {}},
+            {Renderer::Slicer,
+             boxes,
+             {Feature::Nearest, Feature::EarlyTermination, Feature::Occlusion},
+             {}},
             {Renderer::Segments,
              segments,
              {Feature::Nearest, Feature::EarlyTermination, Feature::SampleCounts},
@@ -169,7 +197,9 @@ const std::vector<RendererCapabilities>& capabilities() {
     return table;
 }
 
-const RendererCapabilities& capabilities(Renderer r) { return capabilities()[size_t(r)]; }
+const RendererCapabilities& capabilities(Renderer r) {
+    return capabilities()[size_t(r)];
+}
 
 // ---- A TF's rendering ---------------------------------------------------------------------------
 void apply_tf_rendering(const TfRendering& r, FrameSpec& spec, const TfRenderingOverrides& given) {
@@ -199,7 +229,9 @@ namespace {
     throw FrameError(field, expected);
 }
 
-bool finite(float v) { return std::isfinite(v); }
+bool finite(float v) {
+    return std::isfinite(v);
+}
 
 // The features a spec uses, each with the field that switches it on.
 std::vector<std::pair<Feature, const char*>> used_features(const FrameSpec& s) {
@@ -251,12 +283,14 @@ void validate_structure(const Structure& st) {
                     fail("structure.min_volume", "expected a fraction in 0..1");
                 if (!(v.min_gain >= 0.f && v.min_gain <= 1.f))
                     fail("structure.min_gain", "expected a fraction in 0..1");
-                if (v.max_depth < 0 || v.max_depth > 64) fail("structure.max_depth", "expected 0..64");
+                if (v.max_depth < 0 || v.max_depth > 64)
+                    fail("structure.max_depth", "expected 0..64");
             }
             if constexpr (std::is_same_v<T, structure::GrowingBoxes>) {  // validate(BoxesOptions)'s
                 if (!(v.coalesce <= 1.f))
                     fail("structure.coalesce", "expected a share <= 1 (negative: off)");
-                if (!(v.coalesce_edge > 0.f)) fail("structure.coalesce_edge", "expected a length > 0 (mm)");
+                if (!(v.coalesce_edge > 0.f))
+                    fail("structure.coalesce_edge", "expected a length > 0 (mm)");
             }
         },
         st);
@@ -274,13 +308,15 @@ void validate(const FrameSpec& s) {
         fail("camera.orbit.fov_y_deg", "expected 0 < degrees < 180");
     if (!finite(o.azimuth_deg) || !finite(o.elevation_deg))
         fail("camera.orbit", "expected finite azimuth and elevation degrees");
-    if (!finite(s.camera.pan_x) || !finite(s.camera.pan_y)) fail("camera.pan", "expected finite numbers");
+    if (!finite(s.camera.pan_x) || !finite(s.camera.pan_y))
+        fail("camera.pan", "expected finite numbers");
     if (o.up != Vec3f{0, 0, 1}) {  // the superior default has its own fallback (Camera::orbit)
         const float n = length(o.up);
         if (!finite(o.up.x) || !finite(o.up.y) || !finite(o.up.z) || !(n > 0.f) || !finite(n))
             fail("camera.orbit.up", "expected a finite non-zero direction");
         // Camera::orbit's direction to the eye; up must leave a view plane component.
-        const float az = o.azimuth_deg * float(M_PI) / 180.f, el = o.elevation_deg * float(M_PI) / 180.f;
+        const float az = o.azimuth_deg * float(M_PI) / 180.f,
+                    el = o.elevation_deg * float(M_PI) / 180.f;
         const Vec3f to_eye{-std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
         if (std::abs(dot(o.up, to_eye)) > 0.999f * n)
             fail("camera.orbit.up", "expected a direction not parallel to the view direction");

@@ -27,8 +27,8 @@
 #include <array>
 #include <iterator>
 #include <memory>
-#include <string>
 #include <optional>
+#include <string>
 #include <tuple>
 #include <type_traits>
 #include <variant>
@@ -108,17 +108,17 @@ constexpr Line<Spec, Ray> line(const char* name, std::optional<AccelKind> kind,
 
 inline constexpr std::tuple kTable{
     //   alternative                ray face         name, kind, box face, labels
-    line<structure::None,           NoAccel>       ("none", AccelKind::None, whole_volume),
-    line<structure::Distance,       DistanceMap>   ("distance", AccelKind::Distance),
-    line<structure::Chebyshev,      DistanceMap>   ("chebyshev", AccelKind::Chebyshev),
-    line<structure::Boolean,        BooleanOctree> ("boolean", AccelKind::Boolean),
-    line<structure::MinMax,         MinMaxOctree>  ("minmax", AccelKind::MinMax),
-    line<structure::Bitfield,       BitfieldOctree>("bitfield", AccelKind::Bitfield),
-    line<structure::KdTree,         KdTree>        ("kdtree", AccelKind::KdTree, kdtree_boxes),
-    line<structure::MinMaxInterval, MinMaxOctree>  ("minmax-interval", AccelKind::MinMaxInterval),
-    line<structure::Grid,           BrickGrid>     ("grid", AccelKind::Grid),
-    line<structure::GrowingBoxes>                  ("boxes", std::nullopt, growing_boxes),
-    line<structure::LabelOctree>                   ("label-octree", std::nullopt, nullptr, true),
+    line<structure::None, NoAccel>("none", AccelKind::None, whole_volume),
+    line<structure::Distance, DistanceMap>("distance", AccelKind::Distance),
+    line<structure::Chebyshev, DistanceMap>("chebyshev", AccelKind::Chebyshev),
+    line<structure::Boolean, BooleanOctree>("boolean", AccelKind::Boolean),
+    line<structure::MinMax, MinMaxOctree>("minmax", AccelKind::MinMax),
+    line<structure::Bitfield, BitfieldOctree>("bitfield", AccelKind::Bitfield),
+    line<structure::KdTree, KdTree>("kdtree", AccelKind::KdTree, kdtree_boxes),
+    line<structure::MinMaxInterval, MinMaxOctree>("minmax-interval", AccelKind::MinMaxInterval),
+    line<structure::Grid, BrickGrid>("grid", AccelKind::Grid),
+    line<structure::GrowingBoxes>("boxes", std::nullopt, growing_boxes),
+    line<structure::LabelOctree>("label-octree", std::nullopt, nullptr, true),
 };
 inline constexpr size_t kCount = std::tuple_size_v<decltype(kTable)>;
 template <size_t I>
@@ -128,17 +128,21 @@ using LineAt = std::remove_cvref_t<decltype(std::get<I>(kTable))>;
 static_assert(kCount == std::variant_size_v<Structure>,
               "one registry line per alternative of lacuna::Structure");
 template <size_t I>
-constexpr bool kDescribes = std::is_same_v<typename LineAt<I>::spec,
-                                           std::variant_alternative_t<I, Structure>>;
-static_assert([]<size_t... I>(std::index_sequence<I...>) { return (kDescribes<I> && ...); }(
-                  std::make_index_sequence<kCount>{}),
-              "registry line I must describe alternative I of Structure");
+constexpr bool kDescribes =
+    std::is_same_v<typename LineAt<I>::spec, std::variant_alternative_t<I, Structure>>;
+static_assert(
+    []<size_t... I>(std::index_sequence<I...>) {
+        return (kDescribes<I> && ...);
+    }(std::make_index_sequence<kCount>{}),
+    "registry line I must describe alternative I of Structure");
 
 // The entries, in table order (what the names, factories and capabilities iterate).
-inline constexpr std::array<Entry, kCount> kStructures = std::apply(
-    [](const auto&... l) { return std::array<Entry, kCount>{l.entry...}; }, kTable);
+inline constexpr std::array<Entry, kCount> kStructures =
+    std::apply([](const auto&... l) { return std::array<Entry, kCount>{l.entry...}; }, kTable);
 
-inline const Entry& entry(const Structure& s) { return kStructures[s.index()]; }
+inline const Entry& entry(const Structure& s) {
+    return kStructures[s.index()];
+}
 // The entry named `name` (nullptr: none).
 inline const Entry* find(const std::string& name) {
     for (const Entry& e : kStructures)
@@ -148,7 +152,9 @@ inline const Entry* find(const std::string& name) {
 
 // The octree traversal parameters, where a structure has them.
 template <class T>
-constexpr bool kHasOctree = requires(T t) { t.octree; };
+constexpr bool kHasOctree = requires(T t) {
+    t.octree;
+};
 
 // ---- The dispatch to the concrete ray type (STYLE.md habit 2) --------------------------------
 // visit_accel(a, f) calls f with `a` as the concrete type of the line whose kind is a.kind(),

@@ -16,7 +16,9 @@ namespace {
 class KdTreeBoxSource final : public BoxSource {
   public:
     KdTreeBoxSource(const Volume& v, const AccelOptions& o) : m_tree(v, o) {}
-    void set_transfer_function(const TransferLut& lut) override { m_tree.set_transfer_function(lut); }
+    void set_transfer_function(const TransferLut& lut) override {
+        m_tree.set_transfer_function(lut);
+    }
     std::vector<CellBox> boxes_front_to_back(Vec3f eye) const override {
         return m_tree.boxes_in_visibility_order(eye);
     }
@@ -31,7 +33,8 @@ class KdTreeBoxSource final : public BoxSource {
 
 }  // namespace
 
-std::unique_ptr<BoxSource> make_kdtree_box_source(const Volume& volume, const AccelOptions& options) {
+std::unique_ptr<BoxSource> make_kdtree_box_source(const Volume& volume,
+                                                  const AccelOptions& options) {
     return std::make_unique<KdTreeBoxSource>(volume, options);
 }
 

@@ -28,7 +28,8 @@ class VolumeBoxSource final : public BoxSource {
 
 // The kd-tree paper's subvolume list (Section 2.2) as the slicer renders it: the list boxes, near
 // child of every split first.
-std::unique_ptr<BoxSource> make_kdtree_box_source(const Volume& volume, const AccelOptions& options);
+std::unique_ptr<BoxSource> make_kdtree_box_source(const Volume& volume,
+                                                  const AccelOptions& options);
 
 // Names make_box_source accepts: the registry's structures with a box face
 // (src/session/structure_registry.h).

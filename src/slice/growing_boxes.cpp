@@ -267,7 +267,6 @@ std::string to_string(BoxType t) {
     }
 }
 
-
 std::string to_string(const CellBox& b) {
     char buf[120];
     std::snprintf(buf, sizeof buf, "[%d,%d,%d)-[%d,%d,%d)", b.lo[0], b.lo[1], b.lo[2], b.hi[0],

@@ -65,7 +65,7 @@ struct BoxesOptions {
     // times spacing): boxes stay fine enough for occlusion culling and clipping, and about as
     // large on screen whatever the voxel size.
     float coalesce_edge = 64.f;
-    int threads = 0;              // 0 = all
+    int threads = 0;  // 0 = all
 };
 // Throws lacuna::FrameError naming the field ("structure.spread", ...) for a bad value.
 void validate(const BoxesOptions& o);

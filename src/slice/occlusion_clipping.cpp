@@ -6,10 +6,14 @@ namespace lacuna {
 
 std::string to_string(OcclusionMode m) {
     switch (m) {
-        case OcclusionMode::Off: return "off";
-        case OcclusionMode::CullClip: return "cull+clip";
-        case OcclusionMode::CullOnly: return "cull";
-        case OcclusionMode::MapOnly: return "map-only";
+        case OcclusionMode::Off:
+            return "off";
+        case OcclusionMode::CullClip:
+            return "cull+clip";
+        case OcclusionMode::CullOnly:
+            return "cull";
+        case OcclusionMode::MapOnly:
+            return "map-only";
     }
     return "?";
 }
@@ -45,8 +49,10 @@ int AdaptiveUpdates::poll_slot() const {
     for (int s = 0; s < int(m_slots.size()); ++s) {
         const Slot& a = m_slots[size_t(s)];
         const Slot& b = m_slots[size_t(best)];
-        if (!a.valid && b.valid) best = s;
-        else if (a.valid == b.valid && a.valid && a.age > b.age) best = s;
+        if (!a.valid && b.valid)
+            best = s;
+        else if (a.valid == b.valid && a.valid && a.age > b.age)
+            best = s;
     }
     return best;
 }
@@ -70,8 +76,7 @@ void AdaptiveUpdates::report(double skipped_fraction, int actual_updates) {
             slot.valid = false;
         }
     }
-    if (!std::all_of(m_slots.begin(), m_slots.end(), [](const Slot& x) { return x.valid; }))
-        return;
+    if (!std::all_of(m_slots.begin(), m_slots.end(), [](const Slot& x) { return x.valid; })) return;
     int best = 0;
     for (int i = 1; i < int(m_slots.size()); ++i)
         if (m_slots[size_t(i)].performance > m_slots[size_t(best)].performance) best = i;

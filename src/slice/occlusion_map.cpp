@@ -171,8 +171,10 @@ MapRect OcclusionMap::visible(const MapRect& r, float threshold) const {
     if (r.v0 < e.v0) out.add({r.u0, r.v0, r.u1, std::min(r.v1, e.v0)});
     if (r.v1 > e.v1) out.add({r.u0, std::max(r.v0, e.v1), r.u1, r.v1});
     // Cells that meet R_p (closed, with a rounding margin), through the hierarchy.
-    const double i0 = std::floor((r.u0 - e.u0) / m_cu - 1e-3), i1 = std::floor((r.u1 - e.u0) / m_cu + 1e-3);
-    const double j0 = std::floor((r.v0 - e.v0) / m_cv - 1e-3), j1 = std::floor((r.v1 - e.v0) / m_cv + 1e-3);
+    const double i0 = std::floor((r.u0 - e.u0) / m_cu - 1e-3),
+                 i1 = std::floor((r.u1 - e.u0) / m_cu + 1e-3);
+    const double j0 = std::floor((r.v0 - e.v0) / m_cv - 1e-3),
+                 j1 = std::floor((r.v1 - e.v0) / m_cv + 1e-3);
     if (i1 >= 0 && i0 < m_n && j1 >= 0 && j0 < m_n) {
         MapRect cells;
         const int top = int(m_levels.size()) - 1;

@@ -31,7 +31,7 @@ namespace lacuna {
 struct MapRect {
     double u0 = 1, v0 = 1, u1 = 0, v1 = 0;  // empty when u0 > u1 or v0 > v1
     bool empty() const { return u0 > u1 || v0 > v1; }
-    void add(const MapRect& r);             // bounding rectangle of the union
+    void add(const MapRect& r);  // bounding rectangle of the union
     MapRect intersect(const MapRect& r) const;
 };
 
@@ -79,7 +79,7 @@ class OcclusionMap {
     bool m_persp = true;
     bool m_valid_geometry = true;
     bool m_valid = false;
-    double m_plane = 0;   // P
+    double m_plane = 0;      // P
     Vec3d m_eye{}, m_dir{};  // index space (eye for perspective, direction for orthographic)
     MapRect m_extent;
     double m_cu = 1, m_cv = 1;  // cell size

@@ -8,7 +8,9 @@ namespace lacuna {
 
 namespace {
 
-constexpr int edge_axis(int e) { return e / 4; }
+constexpr int edge_axis(int e) {
+    return e / 4;
+}
 // The endpoint of edge e on its axis' lo (end = 0) or hi (end = 1) side.
 constexpr int edge_vertex(int e, int end) {
     const int a = e / 4, b = e % 4, a1 = (a + 1) % 3, a2 = (a + 2) % 3;
@@ -176,7 +178,8 @@ void IncrementalSlicer::advance() {
         } while (std::next_permutation(order, order + nfound));
         for (int k = 0; k < nfound; ++k) {
             const int e = found[best[k]];
-            m_list.insert(m_list.begin() + std::ptrdiff_t(i) + k, Active{e, intersect(e, m_c), true});
+            m_list.insert(m_list.begin() + std::ptrdiff_t(i) + k,
+                          Active{e, intersect(e, m_c), true});
         }
         i += size_t(nfound);
     }

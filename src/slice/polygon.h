@@ -64,7 +64,7 @@ class IncrementalSlicer {
     double m_lo[3], m_hi[3], m_n[3];
     double m_c, m_dc;
     double m_gmin, m_gmax;
-    double m_delta[3];  // deltaPos per edge axis (0 for an edge parallel to the planes)
+    double m_delta[3];           // deltaPos per edge axis (0 for an edge parallel to the planes)
     std::vector<Active> m_list;  // the ActiveIntersectionList, cyclic order
     bool m_started = false;
     long long m_direct = 0, m_incremental = 0;

@@ -20,24 +20,28 @@ namespace lacuna {
 
 std::string to_string(const SliceStats& s) {
     char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "%.1f ms (set-up %.1f%% of CPU, %.1f%% of wall; occlusion %.1f ms), %llu samples, "
-                  "%llu polygons, "
-                  "%llu boxes (%llu culled, %llu clipped), %.1f%% voxels skipped, %d/%d map updates",
-                  s.seconds * 1e3, 100 * s.setup_cpu_fraction(), 100 * s.setup_fraction(),
-                  s.occlusion_seconds * 1e3,
-                  (unsigned long long)s.samples, (unsigned long long)s.polygons,
-                  (unsigned long long)s.boxes, (unsigned long long)s.boxes_culled,
-                  (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction(), s.map_updates,
-                  s.desired_updates);
+    std::snprintf(
+        buf, sizeof buf,
+        "%.1f ms (set-up %.1f%% of CPU, %.1f%% of wall; occlusion %.1f ms), %llu samples, "
+        "%llu polygons, "
+        "%llu boxes (%llu culled, %llu clipped), %.1f%% voxels skipped, %d/%d map updates",
+        s.seconds * 1e3, 100 * s.setup_cpu_fraction(), 100 * s.setup_fraction(),
+        s.occlusion_seconds * 1e3, (unsigned long long)s.samples, (unsigned long long)s.polygons,
+        (unsigned long long)s.boxes, (unsigned long long)s.boxes_culled,
+        (unsigned long long)s.boxes_clipped, 100 * s.skipped_fraction(), s.map_updates,
+        s.desired_updates);
     return buf;
 }
 
 SliceRenderer::SliceRenderer(const Volume& volume) : m_volume(volume) {}
 
-void SliceRenderer::set_transfer_function(const TransferLut& lut) { m_lut = lut; }
+void SliceRenderer::set_transfer_function(const TransferLut& lut) {
+    m_lut = lut;
+}
 
-Box3f SliceRenderer::bounds() const { return world_bounds(m_volume); }
+Box3f SliceRenderer::bounds() const {
+    return world_bounds(m_volume);
+}
 
 namespace {
 
@@ -192,17 +196,19 @@ void raster_tile(const kernel::Grid<T, int64_t>& g, const Rgba* lut, ValueToLut 
             b->vmax < float(y0) - 1.f || b->vmin > float(y1) + 1.f)
             continue;
         for (const Poly& p : b->polys) {
-            if (p.umax < float(x0) - 1.f || p.umin > float(x1) + 1.f ||
-                p.vmax < float(y0) - 1.f || p.vmin > float(y1) + 1.f)
+            if (p.umax < float(x0) - 1.f || p.umin > float(x1) + 1.f || p.vmax < float(y0) - 1.f ||
+                p.vmin > float(y1) + 1.f)
                 continue;
             const float* uv = &b->uv[size_t(p.first) * 2];
             const float zk = (float(p.k) + 0.5f) * dt;  // the plane, independent of the box
             // Rows and columns clamped to the tile before converting (vertices near the eye
             // can project far off screen).
             const int ya = std::max(
-                y0, int(std::ceil(std::clamp(p.vmin - 0.5f - kMargin, float(y0) - 1.f, float(y1)))));
+                y0,
+                int(std::ceil(std::clamp(p.vmin - 0.5f - kMargin, float(y0) - 1.f, float(y1)))));
             const int yb = std::min(
-                y1 - 1, int(std::floor(std::clamp(p.vmax - 0.5f + kMargin, float(y0) - 1.f, float(y1)))));
+                y1 - 1,
+                int(std::floor(std::clamp(p.vmax - 0.5f + kMargin, float(y0) - 1.f, float(y1)))));
             for (int y = ya; y <= yb; ++y) {
                 float u0, u1;
                 const float vc = std::clamp(float(y) + 0.5f, p.vmin, p.vmax);
@@ -211,9 +217,11 @@ void raster_tile(const kernel::Grid<T, int64_t>& g, const Rgba* lut, ValueToLut 
                 // project exactly onto its centre), with a rounding margin; the ownership test
                 // below decides.
                 const int xa = std::max(
-                    x0, int(std::ceil(std::clamp(u0 - 0.5f - kMargin, float(x0) - 1.f, float(x1)))));
+                    x0,
+                    int(std::ceil(std::clamp(u0 - 0.5f - kMargin, float(x0) - 1.f, float(x1)))));
                 const int xb = std::min(
-                    x1 - 1, int(std::floor(std::clamp(u1 - 0.5f + kMargin, float(x0) - 1.f, float(x1)))));
+                    x1 - 1,
+                    int(std::floor(std::clamp(u1 - 0.5f + kMargin, float(x0) - 1.f, float(x1)))));
                 for (int x = xa; x <= xb; ++x) {
                     const size_t i = size_t(y) * size_t(width) + size_t(x);
                     kernel::Accum& acc = fb[i];
@@ -308,8 +316,15 @@ Frame frame_geometry(const Camera& cam, const Vec3d& sp, float step) {
     f.dt_f = step * min_sp;
     f.dt = double(f.dt_f);
     const double W = double(cam.width()), H = double(cam.height());
-    f.screen = {f.eye_world, Vec3d(cam.right()), Vec3d(cam.up()), f.fwd, sp,
-                W / H * cam.half_height(), double(cam.half_height()), W, H,
+    f.screen = {f.eye_world,
+                Vec3d(cam.right()),
+                Vec3d(cam.up()),
+                f.fwd,
+                sp,
+                W / H * cam.half_height(),
+                double(cam.half_height()),
+                W,
+                H,
                 cam.projection() == Projection::Perspective};
     f.screen.prepare();
     return f;
@@ -486,9 +501,10 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
     // 4. Batches of boxes between map updates (one batch without occlusion).
     std::vector<kernel::Accum> fb(size_t(W) * size_t(H));
     const std::vector<Rgba> lut = step_corrected_lut(m_lut, opt.step);
-    const Compositor comp{m_volume, lut, m_lut.map(), px,
-                          f.dt_f, opt.ert >= 1.f ? kNoEarlyTermination : opt.ert,
-                          opt.nearest, W, H, opt.tile, opt.threads};
+    const Compositor comp{m_volume,    lut,        m_lut.map(),
+                          px,          f.dt_f,     opt.ert >= 1.f ? kNoEarlyTermination : opt.ert,
+                          opt.nearest, W,          H,
+                          opt.tile,    opt.threads};
     BatchCutter cutter{boxes, oo, omap.get(), cells, delta_voxels};
     std::vector<BoxWork> work;
     std::vector<std::pair<Vec3d, Vec3d>> regions;
@@ -497,9 +513,9 @@ SliceResult SliceRenderer::render(const Camera& world_cam, const SliceOptions& o
         const auto t_occ = Clock::now();
         const bool update_after = cutter.cut(work, regions, st);  // 4a
         if (omap) st.occlusion_seconds += seconds_since(t_occ);
-        set_up_batch(f, regions, work, opt.threads, st);           // 4b
-        samples += comp.composite(work, fb.data());                // 4c
-        if (update_after) {                                        // 4d
+        set_up_batch(f, regions, work, opt.threads, st);  // 4b
+        samples += comp.composite(work, fb.data());       // 4c
+        if (update_after) {                               // 4d
             const auto t0 = Clock::now();
             omap->update(&fb[0].a, 4);
             ++st.map_updates;

@@ -37,9 +37,10 @@
 namespace lacuna {
 
 struct SliceOptions {
-    float step = 0.5f;  // plane distance in units of the smallest voxel spacing
-    float ert = kNoEarlyTermination;  // per-pixel early termination opacity (>= 1: off, as on the paper's GPU)
-    int threads = 0;    // 0 = all hardware threads
+    float step = 0.5f;                // plane distance in units of the smallest voxel spacing
+    float ert = kNoEarlyTermination;  // per-pixel early termination opacity (>= 1: off, as on the
+                                      // paper's GPU)
+    int threads = 0;                  // 0 = all hardware threads
     Vec3f background{0, 0, 0};
     bool keep_float = false;  // fill SliceResult::rgba_float
     bool nearest = false;     // nearest-voxel samples (lacuna/accel.h, Interpolation::Nearest)

@@ -36,12 +36,24 @@ void hsv_to_rgb(float h, float s, float v, LabelStyle& c) {
     const float i = std::floor(h * 6.f), f = h * 6.f - i;
     const float p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
     switch (int(i) % 6) {
-        case 0: c.r = v, c.g = t, c.b = p; break;
-        case 1: c.r = q, c.g = v, c.b = p; break;
-        case 2: c.r = p, c.g = v, c.b = t; break;
-        case 3: c.r = p, c.g = q, c.b = v; break;
-        case 4: c.r = t, c.g = p, c.b = v; break;
-        default: c.r = v, c.g = p, c.b = q; break;
+        case 0:
+            c.r = v, c.g = t, c.b = p;
+            break;
+        case 1:
+            c.r = q, c.g = v, c.b = p;
+            break;
+        case 2:
+            c.r = p, c.g = v, c.b = t;
+            break;
+        case 3:
+            c.r = p, c.g = q, c.b = v;
+            break;
+        case 4:
+            c.r = t, c.g = p, c.b = v;
+            break;
+        default:
+            c.r = v, c.g = p, c.b = q;
+            break;
     }
 }
 
@@ -56,7 +68,8 @@ std::string read_file(const std::string& path) {
 float unit_number(const json& j, const std::string& path, const std::string& field) {
     if (!j.is_number()) throw Error(path, field, "expected a number in [0,1], got " + j.dump());
     const double v = j.get<double>();
-    if (!(v >= 0.0 && v <= 1.0)) throw Error(path, field, "expected a number in [0,1], got " + j.dump());
+    if (!(v >= 0.0 && v <= 1.0))
+        throw Error(path, field, "expected a number in [0,1], got " + j.dump());
     return float(v);
 }
 
@@ -81,8 +94,8 @@ void apply_json(LabelTable& t, const std::string& text, const std::string& path)
             throw Error(path, f + ".label", "expected an integer label value");
         const long long l = e["label"].get<long long>();
         if (l < 0 || l > kMaxLabel)
-            throw Error(path, f + ".label", "expected 0.." + std::to_string(kMaxLabel) +
-                                                 ", got " + std::to_string(l));
+            throw Error(path, f + ".label",
+                        "expected 0.." + std::to_string(kMaxLabel) + ", got " + std::to_string(l));
         if (l >= t.size()) t.styles.resize(size_t(l) + 1);
         LabelStyle& s = t.styles[size_t(l)];
         for (const auto& [key, v] : e.items()) {
@@ -113,8 +126,9 @@ void apply_json(LabelTable& t, const std::string& text, const std::string& path)
 // 2001" per line) when it exists.
 void apply_lut(LabelTable& t, const std::string& bytes, const std::string& path) {
     if (bytes.size() != 768)
-        throw Error(path, "size", "expected an MRIcron colour table of 768 bytes, got " +
-                                      std::to_string(bytes.size()));
+        throw Error(
+            path, "size",
+            "expected an MRIcron colour table of 768 bytes, got " + std::to_string(bytes.size()));
     for (int l = 0; l < std::min(256, t.size()); ++l) {
         LabelStyle& s = t.styles[size_t(l)];
         s.r = float(uint8_t(bytes[size_t(l)])) / 255.f;
@@ -136,21 +150,23 @@ void apply_lut(LabelTable& t, const std::string& bytes, const std::string& path)
 
 void check_label_volume(const Volume& labels, const Volume* intensity, const std::string& where) {
     if (labels.type() == VoxelType::Float32)
-        throw Error(where, "voxel type", "expected an integer label map (uint8, int16, uint16), got float32");
+        throw Error(where, "voxel type",
+                    "expected an integer label map (uint8, int16, uint16), got float32");
     if (labels.type() == VoxelType::Int16) {
         const int16_t* d = labels.data_as<int16_t>();
         for (size_t i = 0, n = labels.voxel_count(); i < n; ++i)
             if (d[i] < 0)
-                throw Error(where, "labels", "expected non-negative label values, found " +
-                                                 std::to_string(d[i]));
+                throw Error(where, "labels",
+                            "expected non-negative label values, found " + std::to_string(d[i]));
     }
     if (intensity) {
         const Vec3i a = labels.dims(), b = intensity->dims();
         if (a.x != b.x || a.y != b.y || a.z != b.z)
-            throw Error(where, "dims", "expected the intensity volume's " + std::to_string(b.x) +
-                                           "x" + std::to_string(b.y) + "x" + std::to_string(b.z) +
-                                           ", got " + std::to_string(a.x) + "x" +
-                                           std::to_string(a.y) + "x" + std::to_string(a.z));
+            throw Error(where, "dims",
+                        "expected the intensity volume's " + std::to_string(b.x) + "x" +
+                            std::to_string(b.y) + "x" + std::to_string(b.z) + ", got " +
+                            std::to_string(a.x) + "x" + std::to_string(a.y) + "x" +
+                            std::to_string(a.z));
     }
 }
 
@@ -200,8 +216,9 @@ void set_label_visibility(LabelTable& t, const std::string& spec, bool visible,
         };
         const int lo = num(a), hi = num(b);
         if (lo > hi || hi > kMaxLabel)
-            throw Error(where, "labels", "expected ranges lo-hi with lo <= hi <= " +
-                                             std::to_string(kMaxLabel) + ", got '" + item + "'");
+            throw Error(where, "labels",
+                        "expected ranges lo-hi with lo <= hi <= " + std::to_string(kMaxLabel) +
+                            ", got '" + item + "'");
         if (hi >= t.size()) t.styles.resize(size_t(hi) + 1);
         for (int l = lo; l <= hi; ++l) t.styles[size_t(l)].visible = visible;
         any = true;
@@ -209,7 +226,9 @@ void set_label_visibility(LabelTable& t, const std::string& spec, bool visible,
     if (!any) throw Error(where, "labels", "expected at least one label");
 }
 
-std::string to_string(SegmentMode m) { return m == SegmentMode::Labels ? "labels" : "mask"; }
+std::string to_string(SegmentMode m) {
+    return m == SegmentMode::Labels ? "labels" : "mask";
+}
 
 SegmentMode parse_segment_mode(const std::string& s, const std::string& where) {
     if (s == "labels") return SegmentMode::Labels;

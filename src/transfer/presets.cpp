@@ -211,9 +211,14 @@ struct PresetEntry {
     TransferFunction (*make)();
 };
 constexpr PresetEntry kPresets[] = {
-    {"ct-bone", ct_bone},       {"ct-skin", ct_skin}, {"ct-soft-tissue", ct_soft_tissue},
-    {"mr-default", mr_default}, {"mr-skin", mr_skin}, {"mr-brain", mr_brain},
-    {"mr-gap", mr_gap},         {"label-band", label_band},
+    {"ct-bone", ct_bone},
+    {"ct-skin", ct_skin},
+    {"ct-soft-tissue", ct_soft_tissue},
+    {"mr-default", mr_default},
+    {"mr-skin", mr_skin},
+    {"mr-brain", mr_brain},
+    {"mr-gap", mr_gap},
+    {"label-band", label_band},
     {"CT-AAA", [] { return slicer_builtin("CT-AAA"); }},
     {"CT-Bone", [] { return slicer_builtin("CT-Bone"); }},
     {"CT-Lung", [] { return slicer_builtin("CT-Lung"); }},
@@ -261,9 +266,9 @@ TransferFunction resolve_transfer_function(const std::string& spec) {
     const bool json_name = lower.ends_with(".json");
     if (json_name || std::filesystem::is_regular_file(spec, ec))
         return load_transfer_function(spec);
-    throw Error(
-        "tf", "preset",
-        "unknown preset '" + spec + "'; expected one of: " + joined_names() + " or a .json file (or slicer:FILE.xml#NAME, FILE.vp, FILE.vp.json)");
+    throw Error("tf", "preset",
+                "unknown preset '" + spec + "'; expected one of: " + joined_names() +
+                    " or a .json file (or slicer:FILE.xml#NAME, FILE.vp, FILE.vp.json)");
 }
 
 }  // namespace lacuna

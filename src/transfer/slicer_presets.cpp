@@ -81,8 +81,9 @@ std::vector<double> numbers(const std::string& text, const std::string& where,
 
 double in_unit(double v, const std::string& where, const std::string& field, const char* what) {
     if (!(v >= 0.0 && v <= 1.0))
-        throw Error(where, field,
-                    std::string("expected ") + what + " in [0,1], got " + tf_detail::double_text(v));
+        throw Error(
+            where, field,
+            std::string("expected ") + what + " in [0,1], got " + tf_detail::double_text(v));
     return v;
 }
 
@@ -181,7 +182,8 @@ ValueRange range_of(double lo, double hi, const std::string& where, const std::s
                     const std::string& text) {
     const ValueRange r{float(lo), float(hi)};
     if (!(std::isfinite(r.min) && std::isfinite(r.max) && r.min < r.max))
-        throw Error(where, field, "expected two finite numbers lo < hi, got '" + shorten(text) + "'");
+        throw Error(where, field,
+                    "expected two finite numbers lo < hi, got '" + shorten(text) + "'");
     return r;
 }
 
@@ -225,16 +227,18 @@ SlicerVolumeProperty xml_entry(const XmlEntry& e, const std::string& where) {
         return *v;
     };
     const std::string f = entry + ": ";
-    p.scalar_opacity = opacity_points(need("scalarOpacity", "\"N x a x a ...\""), where,
-                                      f + "scalarOpacity");
+    p.scalar_opacity =
+        opacity_points(need("scalarOpacity", "\"N x a x a ...\""), where, f + "scalarOpacity");
     p.color = color_points(need("colorTransfer", "\"N x r g b ...\""), where, f + "colorTransfer");
     if (const std::string* v = get("gradientOpacity"))
         p.gradient_opacity = opacity_points(*v, where, f + "gradientOpacity");
     if (const std::string* v = get("interpolation"))
         p.interpolation = interpolation_code(*v, where, f + "interpolation");
     if (const std::string* v = get("shade")) p.shading.shade = flag(*v, where, f + "shade");
-    if (const std::string* v = get("ambient")) p.shading.ambient = float(scalar(*v, where, f + "ambient"));
-    if (const std::string* v = get("diffuse")) p.shading.diffuse = float(scalar(*v, where, f + "diffuse"));
+    if (const std::string* v = get("ambient"))
+        p.shading.ambient = float(scalar(*v, where, f + "ambient"));
+    if (const std::string* v = get("diffuse"))
+        p.shading.diffuse = float(scalar(*v, where, f + "diffuse"));
     if (const std::string* v = get("specular"))
         p.shading.specular = float(scalar(*v, where, f + "specular"));
     if (const std::string* v = get("specularPower"))
@@ -265,14 +269,15 @@ double json_number(const json& v, const std::string& where, const std::string& f
 }
 
 void linear_segment(const json& pt, const std::string& where, const std::string& field) {
-    const double mid = json_number(member(pt, "midpoint", where, field + ".", "0.5"), where,
-                                   field + ".midpoint");
-    const double sharp = json_number(member(pt, "sharpness", where, field + ".", "0"), where,
-                                     field + ".sharpness");
+    const double mid =
+        json_number(member(pt, "midpoint", where, field + ".", "0.5"), where, field + ".midpoint");
+    const double sharp =
+        json_number(member(pt, "sharpness", where, field + ".", "0"), where, field + ".sharpness");
     if (mid != 0.5 || sharp != 0.0)
         throw Error(where, field,
                     "expected midpoint 0.5 and sharpness 0 (lacuna's TFs are piecewise linear), "
-                    "got midpoint " + tf_detail::double_text(mid) + ", sharpness " +
+                    "got midpoint " +
+                        tf_detail::double_text(mid) + ", sharpness " +
                         tf_detail::double_text(sharp));
 }
 
@@ -289,8 +294,10 @@ std::vector<OpacityPoint> json_opacity(const json& fn, const std::string& where,
     const json& pts = points_of(fn, where, field);
     for (size_t i = 0; i < pts.size(); ++i) {
         const std::string f = field + ".points[" + std::to_string(i) + "]";
-        const double x = json_number(member(pts[i], "x", where, f + ".", "a number"), where, f + ".x");
-        const double y = json_number(member(pts[i], "y", where, f + ".", "a number"), where, f + ".y");
+        const double x =
+            json_number(member(pts[i], "x", where, f + ".", "a number"), where, f + ".x");
+        const double y =
+            json_number(member(pts[i], "y", where, f + ".", "a number"), where, f + ".y");
         linear_segment(pts[i], where, f);
         out.push_back({x, float(in_unit(y, where, f + ".y", "opacity"))});
     }
@@ -303,10 +310,12 @@ std::vector<ColorPoint> json_color(const json& fn, const std::string& where,
     const json& pts = points_of(fn, where, field);
     for (size_t i = 0; i < pts.size(); ++i) {
         const std::string f = field + ".points[" + std::to_string(i) + "]";
-        const double x = json_number(member(pts[i], "x", where, f + ".", "a number"), where, f + ".x");
+        const double x =
+            json_number(member(pts[i], "x", where, f + ".", "a number"), where, f + ".x");
         linear_segment(pts[i], where, f);
         if (gray) {
-            const double y = json_number(member(pts[i], "y", where, f + ".", "a number"), where, f + ".y");
+            const double y =
+                json_number(member(pts[i], "y", where, f + ".", "a number"), where, f + ".y");
             const float g = float(in_unit(y, where, f + ".y", "grey"));
             out.push_back({x, g, g, g});
             continue;
@@ -339,15 +348,18 @@ SlicerVolumeProperty json_entry(const json& vp, size_t index, const std::string&
         if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number())
             throw Error(where, path + ".effectiveRange",
                         "expected [lo, hi] with lo < hi, got " + shorten(r.dump()));
-        p.effective_range =
-            range_of(r[0].get<double>(), r[1].get<double>(), where, path + ".effectiveRange", r.dump());
+        p.effective_range = range_of(r[0].get<double>(), r[1].get<double>(), where,
+                                     path + ".effectiveRange", r.dump());
     }
     if (vp.contains("interpolationType")) {
         const json& t = vp["interpolationType"];
         const std::string s = t.is_string() ? t.get<std::string>() : "";
-        if (s == "nearest") p.interpolation = SlicerInterpolation::Nearest;
-        else if (s == "linear") p.interpolation = SlicerInterpolation::Linear;
-        else if (s == "cubic") p.interpolation = SlicerInterpolation::Cubic;
+        if (s == "nearest")
+            p.interpolation = SlicerInterpolation::Nearest;
+        else if (s == "linear")
+            p.interpolation = SlicerInterpolation::Linear;
+        else if (s == "cubic")
+            p.interpolation = SlicerInterpolation::Cubic;
         else
             throw Error(where, path + ".interpolationType",
                         "expected \"nearest\", \"linear\" or \"cubic\", got " + shorten(t.dump()));
@@ -359,7 +371,8 @@ SlicerVolumeProperty json_entry(const json& vp, size_t index, const std::string&
     if (!comps.is_array() || comps.size() != 1)
         throw Error(where, path + ".components",
                     "expected exactly one component (lacuna renders single-component volumes), "
-                    "got " + (comps.is_array() ? std::to_string(comps.size()) : shorten(comps.dump())));
+                    "got " +
+                        (comps.is_array() ? std::to_string(comps.size()) : shorten(comps.dump())));
     const json& c = comps[0];
     const std::string cp = path + ".components[0]";
     if (!c.is_object()) throw Error(where, cp, "expected an object");
@@ -370,10 +383,14 @@ SlicerVolumeProperty json_entry(const json& vp, size_t index, const std::string&
     if (c.contains("lighting")) {
         const json& l = c["lighting"];
         const std::string lp = cp + ".lighting.";
-        p.shading.ambient = float(json_number(member(l, "ambient", where, lp, "a number in [0,1]"), where, lp + "ambient"));
-        p.shading.diffuse = float(json_number(member(l, "diffuse", where, lp, "a number in [0,1]"), where, lp + "diffuse"));
-        p.shading.specular = float(json_number(member(l, "specular", where, lp, "a number in [0,1]"), where, lp + "specular"));
-        p.shading.specular_power = float(json_number(member(l, "specularPower", where, lp, "a number >= 0"), where, lp + "specularPower"));
+        p.shading.ambient = float(json_number(member(l, "ambient", where, lp, "a number in [0,1]"),
+                                              where, lp + "ambient"));
+        p.shading.diffuse = float(json_number(member(l, "diffuse", where, lp, "a number in [0,1]"),
+                                              where, lp + "diffuse"));
+        p.shading.specular = float(json_number(
+            member(l, "specular", where, lp, "a number in [0,1]"), where, lp + "specular"));
+        p.shading.specular_power = float(json_number(
+            member(l, "specularPower", where, lp, "a number >= 0"), where, lp + "specularPower"));
         check_shading(p.shading, where, lp);
     }
     if (c.contains("disableGradientOpacity")) {
@@ -382,14 +399,16 @@ SlicerVolumeProperty json_entry(const json& vp, size_t index, const std::string&
         p.gradient_opacity_enabled = !c["disableGradientOpacity"].get<bool>();
     }
     if (c.contains("scalarOpacityUnitDistance")) {
-        const double d = json_number(c["scalarOpacityUnitDistance"], where, cp + ".scalarOpacityUnitDistance");
+        const double d =
+            json_number(c["scalarOpacityUnitDistance"], where, cp + ".scalarOpacityUnitDistance");
         if (!(d > 0))
             throw Error(where, cp + ".scalarOpacityUnitDistance",
                         "expected a number > 0, got " + tf_detail::double_text(d));
         p.scalar_opacity_unit_distance = d;
     }
-    p.scalar_opacity = json_opacity(member(c, "scalarOpacity", where, cp + ".", "{\"points\": [...]}"),
-                                    where, cp + ".scalarOpacity");
+    p.scalar_opacity =
+        json_opacity(member(c, "scalarOpacity", where, cp + ".", "{\"points\": [...]}"), where,
+                     cp + ".scalarOpacity");
     if (c.contains("gradientOpacity"))
         p.gradient_opacity = json_opacity(c["gradientOpacity"], where, cp + ".gradientOpacity");
     if (c.contains("rgbTransferFunction"))
@@ -397,8 +416,9 @@ SlicerVolumeProperty json_entry(const json& vp, size_t index, const std::string&
     else if (c.contains("grayTransferFunction"))
         p.color = json_color(c["grayTransferFunction"], where, cp + ".grayTransferFunction", true);
     else
-        throw Error(where, cp + ".rgbTransferFunction",
-                    "missing; expected a colour function (rgbTransferFunction or grayTransferFunction)");
+        throw Error(
+            where, cp + ".rgbTransferFunction",
+            "missing; expected a colour function (rgbTransferFunction or grayTransferFunction)");
     return p;
 }
 
@@ -406,9 +426,12 @@ SlicerVolumeProperty json_entry(const json& vp, size_t index, const std::string&
 
 std::string to_string(SlicerInterpolation i) {
     switch (i) {
-        case SlicerInterpolation::Nearest: return "nearest";
-        case SlicerInterpolation::Linear: return "linear";
-        case SlicerInterpolation::Cubic: return "cubic";
+        case SlicerInterpolation::Nearest:
+            return "nearest";
+        case SlicerInterpolation::Linear:
+            return "linear";
+        case SlicerInterpolation::Cubic:
+            return "cubic";
     }
     return "?";
 }
@@ -449,8 +472,9 @@ std::vector<SlicerVolumeProperty> parse_slicer_presets_xml(const std::string& xm
         out.push_back(xml_entry(e, where));
         for (size_t i = 0; i + 1 < out.size(); ++i)
             if (out[i].name == out.back().name)
-                throw Error(where, "VolumeProperty \"" + out.back().name + "\" (line " +
-                                       std::to_string(e.line) + ")",
+                throw Error(where,
+                            "VolumeProperty \"" + out.back().name + "\" (line " +
+                                std::to_string(e.line) + ")",
                             "expected unique names, the name is used twice");
     }
     return out;
@@ -465,17 +489,15 @@ SlicerVolumeProperty parse_slicer_vp(const std::string& text, const std::string&
         lines.push_back(l);
     }
     while (!lines.empty() && tokens(lines.back()).empty()) lines.pop_back();
-    static const char* kLines[9] = {"interpolation",   "shade",           "diffuse",
-                                    "ambient",         "specular",        "specular power",
-                                    "scalar opacity",  "gradient opacity", "colour transfer"};
+    static const char* kLines[9] = {
+        "interpolation",  "shade",          "diffuse",          "ambient",        "specular",
+        "specular power", "scalar opacity", "gradient opacity", "colour transfer"};
     if (lines.size() != 9)
         throw Error(where, "lines",
                     "expected 9 lines (interpolation, shade, diffuse, ambient, specular, specular "
                     "power, scalar opacity, gradient opacity, colour), got " +
                         std::to_string(lines.size()));
-    auto field = [&](int i) {
-        return "line " + std::to_string(i + 1) + " (" + kLines[i] + ")";
-    };
+    auto field = [&](int i) { return "line " + std::to_string(i + 1) + " (" + kLines[i] + ")"; };
     SlicerVolumeProperty p;
     p.source = where;
     std::string stem = std::filesystem::path(where).filename().string();

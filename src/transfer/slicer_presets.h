@@ -40,15 +40,15 @@ std::string to_string(SlicerInterpolation i);
 // VTK / Slicer shading parameters (vtkVolumeProperty), defaults as in Slicer's schema.
 struct SlicerShading {
     bool shade = false;
-    float ambient = 0.1f;        // [0,1]
-    float diffuse = 0.7f;        // [0,1]
-    float specular = 0.2f;       // [0,1]
-    float specular_power = 10.f; // >= 0
+    float ambient = 0.1f;         // [0,1]
+    float diffuse = 0.7f;         // [0,1]
+    float specular = 0.2f;        // [0,1]
+    float specular_power = 10.f;  // >= 0
     friend bool operator==(const SlicerShading&, const SlicerShading&) = default;
 };
 
 struct SlicerVolumeProperty {
-    std::string name;    // preset name (presets.xml), file stem (.vp), "name" key or index (.vp.json)
+    std::string name;  // preset name (presets.xml), file stem (.vp), "name" key or index (.vp.json)
     std::string source;  // file the entry came from
     SlicerInterpolation interpolation = SlicerInterpolation::Linear;
     SlicerShading shading;
@@ -57,7 +57,7 @@ struct SlicerVolumeProperty {
     bool gradient_opacity_enabled = true;        // .vp.json disableGradientOpacity = false
     std::vector<ColorPoint> color;               // x in data units; sorted, one point per x
     std::optional<ValueRange> effective_range;
-    double scalar_opacity_unit_distance = 1.0;   // .vp.json only (presets.xml, .vp: 1)
+    double scalar_opacity_unit_distance = 1.0;  // .vp.json only (presets.xml, .vp: 1)
 };
 std::string to_string(const SlicerVolumeProperty& p);
 

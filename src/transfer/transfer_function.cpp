@@ -81,7 +81,8 @@ void validate(const TransferFunction& tf, const std::string& where) {
             !(s.specular_power >= 0.f && std::isfinite(s.specular_power)))
             throw Error(where, "shading",
                         "expected ambient, diffuse, specular in [0,1] and a finite specular_power "
-                        ">= 0, got " + shading_text(s));
+                        ">= 0, got " +
+                            shading_text(s));
     }
     if (!r.gradient_opacity.empty()) {
         // Its x is a gradient magnitude (values per mm) whatever the TF's domain: >= 0.
@@ -139,10 +140,14 @@ std::string tf_where(const TransferFunction& tf) {
 
 std::string to_string(BlendMode m) {
     switch (m) {
-        case BlendMode::Composite: return "composite";
-        case BlendMode::Mip: return "mip";
-        case BlendMode::MinIp: return "minip";
-        case BlendMode::Average: return "average";
+        case BlendMode::Composite:
+            return "composite";
+        case BlendMode::Mip:
+            return "mip";
+        case BlendMode::MinIp:
+            return "minip";
+        case BlendMode::Average:
+            return "average";
     }
     return "?";
 }

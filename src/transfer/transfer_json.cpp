@@ -159,7 +159,8 @@ TfShading read_shading(const json& j, const std::string& where) {
         "an object {\"ambient\", \"diffuse\", \"specular\", \"specular_power\"} of numbers";
     if (!j.is_object()) throw Error(where, "shading", "expected " + shape + ", got " + brief(j));
     for (const auto& item : j.items()) {
-        const std::string& key = item.key();  // (a named reference: clang's C++20 captures no bindings)
+        const std::string& key =
+            item.key();  // (a named reference: clang's C++20 captures no bindings)
         if (std::find_if(kShadingKeys.begin(), kShadingKeys.end(),
                          [&](const char* k) { return key == k; }) == kShadingKeys.end())
             throw Error(where, "shading." + key, "unknown key; expected " + shape);
@@ -269,11 +270,14 @@ TransferFunction parse_transfer_function(const std::string& json_text, const std
                                                   return OpacityPoint{v[0], float(v[1])};
                                               });
     // The rendering the TF asks of the frame (TfRendering), each part optional.
-    if (auto it = doc.find("shading"); it != doc.end()) tf.rendering.shading = read_shading(*it, where);
+    if (auto it = doc.find("shading"); it != doc.end())
+        tf.rendering.shading = read_shading(*it, where);
     if (doc.contains("gradient_opacity"))
-        tf.rendering.gradient_opacity = read_points<OpacityPoint, 2>(
-            doc, "gradient_opacity", {"x", "a"}, where, "a in [0,1]",
-            [](const std::array<double, 2>& v) { return OpacityPoint{v[0], float(v[1])}; });
+        tf.rendering.gradient_opacity =
+            read_points<OpacityPoint, 2>(doc, "gradient_opacity", {"x", "a"}, where, "a in [0,1]",
+                                         [](const std::array<double, 2>& v) {
+                                             return OpacityPoint{v[0], float(v[1])};
+                                         });
     if (auto it = doc.find("blend"); it != doc.end()) tf.rendering.blend = read_blend(*it, where);
 
     tf_detail::validate(tf, where);

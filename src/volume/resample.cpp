@@ -68,12 +68,10 @@ void resample_typed(const Volume& in, Volume& out, int threads) {
                     const T* p = base + size_t(mx.i0[size_t(i)]) * sx;
                     // Along x on the four edges, then y, then z.
                     const double c00 = double(p[0]) + wx * (double(p[sx]) - double(p[0]));
-                    const double c10 =
-                        double(p[sy]) + wx * (double(p[sy + sx]) - double(p[sy]));
-                    const double c01 =
-                        double(p[sz]) + wx * (double(p[sz + sx]) - double(p[sz]));
-                    const double c11 = double(p[sz + sy]) +
-                                       wx * (double(p[sz + sy + sx]) - double(p[sz + sy]));
+                    const double c10 = double(p[sy]) + wx * (double(p[sy + sx]) - double(p[sy]));
+                    const double c01 = double(p[sz]) + wx * (double(p[sz + sx]) - double(p[sz]));
+                    const double c11 =
+                        double(p[sz + sy]) + wx * (double(p[sz + sy + sx]) - double(p[sz + sy]));
                     const double c0 = c00 + wy * (c10 - c00);
                     const double c1 = c01 + wy * (c11 - c01);
                     row[i] = store<T>(c0 + wz * (c1 - c0));

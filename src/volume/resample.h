@@ -23,6 +23,8 @@ Volume resample_trilinear(const Volume& in, Vec3i out_dims, int threads = 0);
 
 // Output dims for "about n^3": every axis resampled to n voxels (cubic grids keep the
 // comparison with the paper's 256^3 / 512^3 figures direct; the spacing keeps the shape).
-inline Vec3i cube_dims(int n) { return {n, n, n}; }
+inline Vec3i cube_dims(int n) {
+    return {n, n, n};
+}
 
 }  // namespace lacuna

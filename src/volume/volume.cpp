@@ -16,10 +16,14 @@ namespace lacuna {
 
 std::string to_string(VoxelType t) {
     switch (t) {
-        case VoxelType::UInt8: return "uint8";
-        case VoxelType::Int16: return "int16";
-        case VoxelType::UInt16: return "uint16";
-        case VoxelType::Float32: return "float32";
+        case VoxelType::UInt8:
+            return "uint8";
+        case VoxelType::Int16:
+            return "int16";
+        case VoxelType::UInt16:
+            return "uint16";
+        case VoxelType::Float32:
+            return "float32";
     }
     return "?";
 }
@@ -35,10 +39,13 @@ VoxelType parse_voxel_type(const std::string& name, const std::string& where) {
 
 size_t voxel_size(VoxelType t) {
     switch (t) {
-        case VoxelType::UInt8: return 1;
+        case VoxelType::UInt8:
+            return 1;
         case VoxelType::Int16:
-        case VoxelType::UInt16: return 2;
-        case VoxelType::Float32: return 4;
+        case VoxelType::UInt16:
+            return 2;
+        case VoxelType::Float32:
+            return 4;
     }
     return 1;
 }
@@ -95,10 +102,18 @@ float Volume::value(int i, int j, int k) const {
 void Volume::set_value(int i, int j, int k, float v) {
     size_t idx = index(i, j, k);
     switch (m_type) {
-        case VoxelType::UInt8: data_as<uint8_t>()[idx] = uint8_t(v); break;
-        case VoxelType::Int16: data_as<int16_t>()[idx] = int16_t(v); break;
-        case VoxelType::UInt16: data_as<uint16_t>()[idx] = uint16_t(v); break;
-        case VoxelType::Float32: data_as<float>()[idx] = v; break;
+        case VoxelType::UInt8:
+            data_as<uint8_t>()[idx] = uint8_t(v);
+            break;
+        case VoxelType::Int16:
+            data_as<int16_t>()[idx] = int16_t(v);
+            break;
+        case VoxelType::UInt16:
+            data_as<uint16_t>()[idx] = uint16_t(v);
+            break;
+        case VoxelType::Float32:
+            data_as<float>()[idx] = v;
+            break;
     }
 }
 
@@ -116,7 +131,8 @@ size_t Volume::replace_nan_with_minimum(const std::string& where) {
     }
     if (nans == 0) return 0;
     if (nans == n)
-        throw Error(where, "voxel values", "expected at least one voxel that is not NaN, got NaN only");
+        throw Error(where, "voxel values",
+                    "expected at least one voxel that is not NaN, got NaN only");
     // (lo may be -Inf: then compute_range rejects the volume for its Inf, as without NaN.)
     for (size_t i = 0; i < n; ++i)
         if (std::isnan(p[i])) p[i] = lo;
@@ -159,8 +175,8 @@ void Volume::compute_range(const std::string& where) {
     // non-finite voxels (the totality argument of ValueToLut, transfer_function.h).
     if (!std::isfinite(hi - lo))
         throw Error(where, "voxel values",
-                    "expected max - min within float (3.4e38), got " + std::to_string(lo) +
-                        " .. " + std::to_string(hi));
+                    "expected max - min within float (3.4e38), got " + std::to_string(lo) + " .. " +
+                        std::to_string(hi));
     // Float voxels within an ulp of float's end (fuzz_value_to_lut: corners 1.16e38 and 3.4e38):
     // a trilinear lerp a + f * (b - a) can round one ulp past its corners, which at 3.4e38 is
     // inf. Below 2^127 (1.7e38) three lerps' ulps cannot reach 2^128. Equal corners lerp

@@ -28,14 +28,13 @@ TEST(AccelFactory, MakesEveryKindWithItsOwnType) {
         const Accel& base = *a;
         const std::type_info& dynamic = typeid(base);
         // The structures this file knows; a newer kind only has to agree with visit_accel.
-        const std::type_info* expected = k == AccelKind::None       ? &typeid(NoAccel)
-                                         : k == AccelKind::MinMax || k == AccelKind::MinMaxInterval
-                                             ? &typeid(MinMaxOctree)
-                                         : k == AccelKind::Bitfield ? &typeid(BitfieldOctree)
-                                         : k == AccelKind::Boolean  ? &typeid(BooleanOctree)
-                                         : k == AccelKind::Distance || k == AccelKind::Chebyshev
-                                             ? &typeid(DistanceMap)
-                                             : nullptr;
+        const std::type_info* expected =
+            k == AccelKind::None                                       ? &typeid(NoAccel)
+            : k == AccelKind::MinMax || k == AccelKind::MinMaxInterval ? &typeid(MinMaxOctree)
+            : k == AccelKind::Bitfield                                 ? &typeid(BitfieldOctree)
+            : k == AccelKind::Boolean                                  ? &typeid(BooleanOctree)
+            : k == AccelKind::Distance || k == AccelKind::Chebyshev    ? &typeid(DistanceMap)
+                                                                       : nullptr;
         if (expected) EXPECT_EQ(dynamic, *expected) << to_string(k);
         // visit_accel hands the renderers the same concrete type.
         const std::type_info& visited =

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "accel/cell_ranges.h"
-#include "common/rng.h"
 #include "accel/region.h"
+#include "common/rng.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
 

@@ -2,10 +2,10 @@
 // extreme corners, the TF bitfield, the 128-bit layout, and TF changes that must not touch the
 // TF-independent tree unless the value mapping changes.
 #include "accel/bitfield_octree.h"
-#include "accel/minmax_octree.h"
 
 #include <gtest/gtest.h>
 
+#include "accel/minmax_octree.h"
 #include "accel_test_util.h"
 
 namespace lacuna {
@@ -284,8 +284,8 @@ TEST(BitfieldOctree, NodeBitsAreTheBinRunOfTheMinMaxRangeSoMinMaxSkipsAtLeastAsM
         o.threads = rng.range(0, 2);
         BitfieldOctree bf(v, o);
         MinMaxOctree mm(AccelKind::MinMax, v, o);
-        const std::string what = to_string(v) + " leaf " + std::to_string(o.leaf_cells) +
-                                 " bits " + std::to_string(o.bitfield_bits);
+        const std::string what = to_string(v) + " leaf " + std::to_string(o.leaf_cells) + " bits " +
+                                 std::to_string(o.bitfield_bits);
         for (size_t i = 0; i < mm.pyramid().node_count(); ++i, ++nodes) {
             const MinMaxOctree::Node nd = mm.node(i);
             uint64_t want[2] = {0, 0};

@@ -106,7 +106,8 @@ TEST(BrickGrid, RefinedCellMaskIsTheVisibilityOfEveryCellsRange) {
         const ValueToLut m(v.vis_range(), kDefaultLutSize);
         TransferLut lut = random_lut(v.vis_range(), kDefaultLutSize, rng, voxel_entries(v, m, rng));
         if (trial % 8 == 7)  // everything visible but one entry band: fully visible bricks
-            for (size_t e = 0; e < lut.entries.size(); ++e) lut.entries[e].a = e % 97 < 90 ? 0.5f : 0.f;
+            for (size_t e = 0; e < lut.entries.size(); ++e)
+                lut.entries[e].a = e % 97 < 90 ? 0.5f : 0.f;
         g.set_transfer_function(lut);
         ASSERT_EQ(g.cell_mask(), nullptr) << "no mask before refine()";
         g.refine();
@@ -128,7 +129,8 @@ TEST(BrickGrid, RefinedCellMaskIsTheVisibilityOfEveryCellsRange) {
                     (expect ? visible : invisible)++;
                 }
         for (size_t off = 0; off < v.voxel_count(); ++off)
-            if (!is_cell[off]) ASSERT_FALSE((mask[off >> 5] >> (off & 31)) & 1u) << "offset " << off;
+            if (!is_cell[off])
+                ASSERT_FALSE((mask[off >> 5] >> (off & 31)) & 1u) << "offset " << off;
         g.set_transfer_function(empty_lut(v.vis_range()));
         ASSERT_EQ(g.cell_mask(), nullptr) << "a TF change drops the mask";
     }
@@ -158,7 +160,8 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
             for (size_t e = 0; e < lut.entries.size(); ++e)
                 if (e % 37 != 5) lut.entries[e].a = 0.f;
         if (trial % 8 == 6)  // all but one band visible: fully visible bricks
-            for (size_t e = 0; e < lut.entries.size(); ++e) lut.entries[e].a = e % 97 < 90 ? 0.5f : 0.f;
+            for (size_t e = 0; e < lut.entries.size(); ++e)
+                lut.entries[e].a = e % 97 < 90 ? 0.5f : 0.f;
         g.set_transfer_function(lut);
         ASSERT_EQ(g.leap_map(), nullptr) << "no leap map before refine()";
         g.refine();
@@ -182,7 +185,8 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
         for (int z = 0; z < nf[2]; ++z)
             for (int y = 0; y < nf[1]; ++y)
                 for (int x = 0; x < nf[0]; ++x) {
-                    const int lo[3] = {4 * x - 1, 4 * y - 1, 4 * z - 1}, hi[3] = {4 * x + 4, 4 * y + 4, 4 * z + 4};
+                    const int lo[3] = {4 * x - 1, 4 * y - 1, 4 * z - 1},
+                              hi[3] = {4 * x + 4, 4 * y + 4, 4 * z + 4};
                     occ[(size_t(z) * nf[1] + y) * nf[0] + x] = any_visible(lo, hi);
                 }
         const size_t stride = g.leap_octant_stride();
@@ -202,13 +206,16 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
                             for (int b = 0; b < nf[1]; ++b)
                                 for (int a = 0; a < nf[0]; ++a) {
                                     const int u = sx * (a - x), w = sy * (b - y), t = sz * (c - z);
-                                    if (u < 0 || w < 0 || t < 0 || !occ[(size_t(c) * nf[1] + b) * nf[0] + a]) continue;
+                                    if (u < 0 || w < 0 || t < 0 ||
+                                        !occ[(size_t(c) * nf[1] + b) * nf[0] + a])
+                                        continue;
                                     want = std::min(want, std::max({u, w, t}));
                                 }
                         const uint16_t eo = leap[o * stride + id];
-                        ASSERT_EQ(eo & 0xff, want) << describe(v, lut) << " fine brick " << x << "," << y
-                                                   << "," << z << " octant " << o;
-                        ASSERT_EQ(eo >> 8, leap[id] >> 8) << "the sub-bricks are the same in every octant";
+                        ASSERT_EQ(eo & 0xff, want) << describe(v, lut) << " fine brick " << x << ","
+                                                   << y << "," << z << " octant " << o;
+                        ASSERT_EQ(eo >> 8, leap[id] >> 8)
+                            << "the sub-bricks are the same in every octant";
                         wants[o] = want;
                         dist = std::min(dist, want);  // (the symmetric Chebyshev distance)
                     }
@@ -221,13 +228,16 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
                     }
                     ++near;
                     for (int s = 0; s < 8; ++s) {
-                        const int o3[3] = {4 * x + 2 * (s & 1), 4 * y + 2 * (s >> 1 & 1), 4 * z + 2 * (s >> 2)};
+                        const int o3[3] = {4 * x + 2 * (s & 1), 4 * y + 2 * (s >> 1 & 1),
+                                           4 * z + 2 * (s >> 2)};
                         // (a sub-brick past the grid holds no sample's cell: its bit is free)
                         if (o3[0] >= n[0] || o3[1] >= n[1] || o3[2] >= n[2]) continue;
-                        const int lo[3] = {o3[0] - 1, o3[1] - 1, o3[2] - 1}, hi[3] = {o3[0] + 2, o3[1] + 2, o3[2] + 2};
+                        const int lo[3] = {o3[0] - 1, o3[1] - 1, o3[2] - 1},
+                                  hi[3] = {o3[0] + 2, o3[1] + 2, o3[2] + 2};
                         const bool expect = any_visible(lo, hi);
                         ASSERT_EQ(bool(e >> (8 + s) & 1), expect)
-                            << describe(v, lut) << " fine brick " << x << "," << y << "," << z << " sub-brick " << s;
+                            << describe(v, lut) << " fine brick " << x << "," << y << "," << z
+                            << " sub-brick " << s;
                         (expect ? sub_set : sub_clear)++;
                     }
                 }

@@ -210,7 +210,7 @@ TEST(Cursor, NoAccelReturnsTheWholeIntervalOnce) {
     NoAccel none;
     for (int q = 0; q < 1000; ++q) {
         const RayParts r{{rng.uniform(), rng.uniform(), rng.uniform()},
-                          {rng.uniform(), 1.f, -rng.uniform()}};
+                         {rng.uniform(), 1.f, -rng.uniform()}};
         const float t_near = 100.f * rng.uniform() - 10.f,
                     t_far = t_near + (q % 10 == 0 ? 0.f : 50.f * rng.uniform());
         NoAccel::Cursor c(none, r, t_near, t_far);

@@ -791,14 +791,18 @@ TEST(KdTreePartition, FewBoxesRemoveMostOfTheEmptySpaceOfASparseTree) {
 namespace fs = std::filesystem;
 
 using CliRun = lacuna::test::CliResult;
-std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
+std::string slurp(const fs::path& p) {
+    return lacuna::test::slurp_file(p);
+}
 
 fs::path temp_dir() {
     static const fs::path dir = lacuna::test::cli_temp_dir("kdtree");
     return dir;
 }
 
-CliRun run_cli(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliRun run_cli(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 TEST(KdTreePartitionCli, WritesBoxesJsonAndOverlayPng) {
     const fs::path vol = temp_dir() / "tree.nrrd", json = temp_dir() / "boxes.json",

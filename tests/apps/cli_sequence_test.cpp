@@ -25,7 +25,9 @@ fs::path temp_dir() {
     return dir;
 }
 
-CliResult run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliResult run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 // The CLI with `env` (e.g. "PATH=/x") in front of it.
 CliResult run_env(const std::string& env, const std::string& args) {
@@ -58,9 +60,13 @@ const fs::path& volume() {
     return p;
 }
 
-std::string render_args() { return "render " + volume().string() + " --tf mr-default --size 40"; }
+std::string render_args() {
+    return "render " + volume().string() + " --tf mr-default --size 40";
+}
 
-size_t lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
+size_t lines(const std::string& s) {
+    return size_t(std::count(s.begin(), s.end(), '\n'));
+}
 
 // Files in the test folder whose name starts with `prefix` (leftovers, temporaries).
 int count_files(const std::string& prefix) {
@@ -84,8 +90,8 @@ TEST(CliProgress, OnAPipeOneSummaryLineAndNothingUnderQuiet) {
     EXPECT_EQ(one.err.rfind("render: 1 frame in ", 0), 0u) << one.err;
     EXPECT_EQ(lines(one.err), 1u) << one.err;
 
-    const CliResult gen = run("generate sphere-shells --dims 9x9x9 --out " +
-                              (temp_dir() / "g.nrrd").string());
+    const CliResult gen =
+        run("generate sphere-shells --dims 9x9x9 --out " + (temp_dir() / "g.nrrd").string());
     ASSERT_EQ(gen.code, 0) << gen.err;
     EXPECT_EQ(gen.err.rfind("generate: done in ", 0), 0u) << gen.err;
 
@@ -97,8 +103,8 @@ TEST(CliProgress, OnAPipeOneSummaryLineAndNothingUnderQuiet) {
     const CliResult q2 = run("--quiet " + render_args() + " --orbit 3 --out " + png.string());
     ASSERT_EQ(q2.code, 0) << q2.err;
     EXPECT_EQ(q2.err, "");
-    const CliResult q3 = run("generate -q sphere-shells --dims 9x9x9 --out " +
-                             (temp_dir() / "g.nrrd").string());
+    const CliResult q3 =
+        run("generate -q sphere-shells --dims 9x9x9 --out " + (temp_dir() / "g.nrrd").string());
     ASSERT_EQ(q3.code, 0) << q3.err;
     EXPECT_EQ(q3.err, "");
     // --quiet never silences an error.
@@ -111,8 +117,8 @@ TEST(CliProgress, OnAPipeOneSummaryLineAndNothingUnderQuiet) {
 TEST(CliProgress, OnATerminalFramesDoneOfTotalWithEta) {
     const fs::path png = temp_dir() / "tty.png";
     int code = -1;
-    const std::string cmd = std::string(LACUNA_CLI_PATH) + " " + render_args() +
-                            " --orbit 5 --out " + png.string();
+    const std::string cmd =
+        std::string(LACUNA_CLI_PATH) + " " + render_args() + " --orbit 5 --out " + png.string();
     const std::string out = shell("script -qec '" + cmd + " >/dev/null' /dev/null", code);
     ASSERT_EQ(code, 0) << out;
     EXPECT_NE(out.find("\rrender: 1/5 frames, "), std::string::npos) << out;
@@ -142,7 +148,8 @@ TEST(CliOrbit, FramesEqualSingleFramesAtTheSameAzimuth) {
         const CliResult s = run(render_args() + " --azimuth " + std::to_string(azimuths[i]) +
                                 " --elevation 20 --accel none --out " + one.string());
         ASSERT_EQ(s.code, 0) << s.err;
-        EXPECT_EQ(slurp_file(one), slurp_file(temp_dir() / ("orb_000" + std::to_string(i) + ".png")))
+        EXPECT_EQ(slurp_file(one),
+                  slurp_file(temp_dir() / ("orb_000" + std::to_string(i) + ".png")))
             << "frame " << i;
     }
     // Not all the same picture (the camera moves).
@@ -158,12 +165,11 @@ TEST(CliOrbit, BadCombinationsAreOneLineAndWriteNothing) {
         run(render_args() + " --orbit 3 --tf-animate mr-default mr-gap --out " + png.string()),
         "--orbit");
     expect_one_line_error(run(render_args() + " --movie m.mp4 --out " + png.string()), "--movie");
-    expect_one_line_error(run(render_args() + " --orbit 2 --movie " +
-                              (temp_dir() / "m.avi").string()),
-                          ".mp4");
-    expect_one_line_error(run(render_args() + " --orbit 2 --fps 0 --movie " +
-                              (temp_dir() / "m.mp4").string()),
-                          "--fps");
+    expect_one_line_error(
+        run(render_args() + " --orbit 2 --movie " + (temp_dir() / "m.avi").string()), ".mp4");
+    expect_one_line_error(
+        run(render_args() + " --orbit 2 --fps 0 --movie " + (temp_dir() / "m.mp4").string()),
+        "--fps");
     EXPECT_EQ(count_files("bad"), 0);
     EXPECT_EQ(count_files("m."), 0);
 }
@@ -171,9 +177,10 @@ TEST(CliOrbit, BadCombinationsAreOneLineAndWriteNothing) {
 // ffprobe's value of `entry` for the first video stream ("" if none).
 std::string probe(const fs::path& mp4, const std::string& entry) {
     int code = -1;
-    std::string v = shell("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=" +
-                              entry + " -of default=noprint_wrappers=1:nokey=1 " + mp4.string(),
-                          code);
+    std::string v =
+        shell("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=" + entry +
+                  " -of default=noprint_wrappers=1:nokey=1 " + mp4.string(),
+              code);
     EXPECT_EQ(code, 0) << v;
     while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
     return v;
@@ -199,7 +206,8 @@ TEST(CliMovie, WritesAnH264Mp4WithEveryFrame) {
     const fs::path anim = temp_dir() / "anim.mp4", png = temp_dir() / "animf.png";
     const CliResult a = run("render " + volume().string() +
                             " --tf-animate mr-default mr-gap --frames 3 --accel minmax --width 41 "
-                            "--height 30 --movie " + anim.string() + " --out " + png.string());
+                            "--height 30 --movie " +
+                            anim.string() + " --out " + png.string());
     ASSERT_EQ(a.code, 0) << a.err;
     EXPECT_EQ(probe(anim, "codec_name"), "h264");
     EXPECT_EQ(probe(anim, "width"), "42");

@@ -2,14 +2,14 @@
 // naming the file and the problem, exit code 2, and leaves no output file behind.
 #include <gtest/gtest.h>
 
-#include "apps/cli_run.h"
-#include "io/io_test_util.h"
-#include "io/nifti_test_file.h"
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "apps/cli_run.h"
+#include "io/io_test_util.h"
+#include "io/nifti_test_file.h"
 
 namespace fs = std::filesystem;
 
@@ -17,14 +17,18 @@ namespace {
 
 using CliRun = lacuna::test::CliResult;
 using lacuna::test::expect_one_line_error;
-std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
+std::string slurp(const fs::path& p) {
+    return lacuna::test::slurp_file(p);
+}
 
 fs::path temp_dir() {
     static const fs::path dir = lacuna::test::cli_temp_dir("cli");
     return dir;
 }
 
-CliRun run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliRun run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 const fs::path& small_volume() {
     static fs::path p = [] {
@@ -39,7 +43,7 @@ const fs::path& small_volume() {
 TEST(Cli, RendersAGeneratedVolumeAndReportsTiming) {
     const fs::path png = temp_dir() / "shells.png", heat = temp_dir() / "shells-heat.png";
     CliRun r = run("render " + small_volume().string() + " --tf mr-default --size 64 --out " +
-                png.string() + " --heatmap " + heat.string());
+                   png.string() + " --heatmap " + heat.string());
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("render time"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("samples/ray"), std::string::npos) << r.out;
@@ -124,7 +128,8 @@ TEST(Cli, MissingVolumeIsOneLineExit2) {
 
 TEST(Cli, UnknownPresetIsOneLineExit2) {
     const fs::path png = temp_dir() / "never.png";
-    CliRun r = run("render " + small_volume().string() + " --tf no-such-preset --out " + png.string());
+    CliRun r =
+        run("render " + small_volume().string() + " --tf no-such-preset --out " + png.string());
     expect_one_line_error(r, "no-such-preset");
     EXPECT_FALSE(fs::exists(png));
 }
@@ -133,14 +138,14 @@ TEST(Cli, MalformedTfJsonIsOneLineExit2) {
     const fs::path tf = temp_dir() / "broken.json", png = temp_dir() / "never.png";
     std::ofstream(tf) << "{\"color\": [[0, 1, 1, 1]], \"opacity\": [[0, 0.5], [0.5,";
     CliRun r = run("render " + small_volume().string() + " --tf " + tf.string() + " --out " +
-                png.string());
+                   png.string());
     expect_one_line_error(r, "broken.json");
     EXPECT_FALSE(fs::exists(png));
 }
 
 TEST(Cli, UnwritableOutputIsOneLineExit2) {
     CliRun r = run("render " + small_volume().string() +
-                " --tf mr-default --size 16 --out /nonexistent-dir/out.png");
+                   " --tf mr-default --size 16 --out /nonexistent-dir/out.png");
     expect_one_line_error(r, "/nonexistent-dir/out.png");
     fs::path ro = temp_dir() / "readonly";
     fs::create_directories(ro);
@@ -148,7 +153,7 @@ TEST(Cli, UnwritableOutputIsOneLineExit2) {
     // root ignores permission bits; the check only means something for other users.
     if (::geteuid() != 0) {
         CliRun r2 = run("render " + small_volume().string() + " --tf mr-default --size 16 --out " +
-                     (ro / "out.png").string());
+                        (ro / "out.png").string());
         expect_one_line_error(r2, "out.png");
     }
     fs::permissions(ro, fs::perms::owner_all);
@@ -193,18 +198,20 @@ TEST(Cli, RawVolumeWithExplicitLayout) {
     for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i % 200);
     std::ofstream(raw, std::ios::binary) << bytes;
     CliRun ok = run("render " + raw.string() +
-                 " --dims 12x10x8 --type uint8 --tf mr-default --size 16 --out " + png.string());
+                    " --dims 12x10x8 --type uint8 --tf mr-default --size 16 --out " + png.string());
     EXPECT_EQ(ok.code, 0) << ok.err;
     CliRun bad = run("info " + raw.string() + " --dims 12x10x9 --type uint8");
     expect_one_line_error(bad, "ramp.raw");
     // --spacing completes a raw layout, given by flags or by the file's name; nothing else.
-    CliRun spaced = run("info " + raw.string() + " --dims 12x10x8 --type uint8 --spacing 0.5,2,1.25");
+    CliRun spaced =
+        run("info " + raw.string() + " --dims 12x10x8 --type uint8 --spacing 0.5,2,1.25");
     EXPECT_EQ(spaced.code, 0) << spaced.err;
     EXPECT_NE(spaced.out.find("spacing:     0.5 x 2 x 1.25 mm"), std::string::npos) << spaced.out;
     const fs::path named = temp_dir() / "ramp_12x10x8_uint8.raw";
     fs::copy_file(raw, named, fs::copy_options::overwrite_existing);
     spaced = run("info " + named.string() + " --spacing 3,1,1");
-    EXPECT_NE(spaced.out.find("spacing:     3 x 1 x 1 mm"), std::string::npos) << spaced.out + spaced.err;
+    EXPECT_NE(spaced.out.find("spacing:     3 x 1 x 1 mm"), std::string::npos)
+        << spaced.out + spaced.err;
     for (const char* s : {"0,1,1", "1,1", "1,1,1,1", "a,1,1", "nan,1,1", "1,-2,1"})
         expect_one_line_error(run("info " + named.string() + " --spacing " + s), "--spacing");
     expect_one_line_error(run("info " + small_volume().string() + " --spacing 1,1,1"),
@@ -221,18 +228,22 @@ TEST(Cli, FourDimensionalNiftiTakesAFrame) {
     std::vector<uint8_t> vox(6 * 5 * 4 * 3);
     for (size_t i = 0; i < vox.size(); ++i) vox[i] = uint8_t(100 * (i / 120) + i % 120 / 12);
     const fs::path file = temp_dir() / "series.nii";
-    lacuna::test::write_bytes(file.string(), lacuna::test::nifti_bytes(spec, vox.data(), vox.size()));
+    lacuna::test::write_bytes(file.string(),
+                              lacuna::test::nifti_bytes(spec, vox.data(), vox.size()));
     for (int f = 0; f < 3; ++f) {
         CliRun r = run("info " + file.string() + " --frame " + std::to_string(f));
         EXPECT_EQ(r.code, 0) << r.err;
         const std::string range = std::to_string(100 * f) + " .. " + std::to_string(100 * f + 9);
         EXPECT_NE(r.out.find("value range: " + range), std::string::npos) << r.out;
     }
-    expect_one_line_error(run("info " + file.string()),
-                          "series.nii: frame: the file holds 3 volumes along dim[4]; choose one (0..2)");
-    expect_one_line_error(run("info " + file.string() + " --frame 3"), "frame: expected 0..2, got 3");
+    expect_one_line_error(
+        run("info " + file.string()),
+        "series.nii: frame: the file holds 3 volumes along dim[4]; choose one (0..2)");
+    expect_one_line_error(run("info " + file.string() + " --frame 3"),
+                          "frame: expected 0..2, got 3");
     const fs::path png = temp_dir() / "series.png";
-    CliRun r = run("render " + file.string() + " --frame 2 --tf mr-default --size 16 --out " + png.string());
+    CliRun r = run("render " + file.string() + " --frame 2 --tf mr-default --size 16 --out " +
+                   png.string());
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(png));
 }

@@ -6,10 +6,9 @@
 // The reference of each comparison is the same TF with its rendering removed, written to a file,
 // plus the flags the rule says the rendering stands for: so a test fails if the rule maps a term
 // wrongly, drops one, or applies where a flag was given.
-#include "apps/cli_run.h"
-
 #include <array>
 
+#include "apps/cli_run.h"
 #include "lacuna/image.h"
 #include "lacuna/transfer_function.h"
 
@@ -29,9 +28,10 @@ const std::string& volume(bool ct) {
         std::array<std::string, 2> out;
         for (int i = 0; i < 2; ++i) {
             out[i] = (dir() / (i ? "shells-ct.nrrd" : "shells-mr.nrrd")).string();
-            const CliResult r = run_cli(std::string("generate sphere-shells --type ") +
-                                            (i ? "int16" : "uint8") + " --dims 30x28x26 --out " + out[i],
-                                        dir());
+            const CliResult r =
+                run_cli(std::string("generate sphere-shells --type ") + (i ? "int16" : "uint8") +
+                            " --dims 30x28x26 --out " + out[i],
+                        dir());
             EXPECT_EQ(r.code, 0) << r.err;
         }
         return out;
@@ -39,11 +39,12 @@ const std::string& volume(bool ct) {
     return v[ct ? 1 : 0];
 }
 
-std::string render(const std::string& tf, bool ct, const std::string& extra, const std::string& name) {
+std::string render(const std::string& tf, bool ct, const std::string& extra,
+                   const std::string& name) {
     const std::string png = (dir() / (name + ".png")).string();
     std::filesystem::remove(png);
-    const CliResult r = run_cli("render " + volume(ct) + " --tf '" + tf + "' --size 40 --accel bitfield " +
-                                    extra + " --out " + png,
+    const CliResult r = run_cli("render " + volume(ct) + " --tf '" + tf +
+                                    "' --size 40 --accel bitfield " + extra + " --out " + png,
                                 dir());
     EXPECT_EQ(r.code, 0) << tf << " " << extra << ": " << r.err;
     return slurp_file(png);
@@ -81,7 +82,8 @@ TEST(CliTfRendering, ExplicitFlagsOverrideThePresetsDefaults) {
     EXPECT_EQ(render(xml, true, "--phong 0.3,0.5,0.6,5", "terms"),
               render(plain, true, "--shading phong --phong 0.3,0.5,0.6,5", "terms-explicit"));
     // --shading pbr: the user's model.
-    EXPECT_EQ(render(xml, true, "--shading pbr", "pbr"), render(plain, true, "--shading pbr", "pbr-explicit"));
+    EXPECT_EQ(render(xml, true, "--shading pbr", "pbr"),
+              render(plain, true, "--shading pbr", "pbr-explicit"));
 }
 
 TEST(CliTfRendering, SlicerGradientOpacityIsAppliedUnlessGiven) {
@@ -91,7 +93,8 @@ TEST(CliTfRendering, SlicerGradientOpacityIsAppliedUnlessGiven) {
     const std::string go = render(xml, false, "", "go");
     EXPECT_EQ(go, render(plain, false, "--gradient-opacity 0:0.5,20:1,255:1", "go-explicit"));
     EXPECT_NE(go, render(plain, false, "", "go-flat"));
-    EXPECT_EQ(render(xml, false, "--gradient-opacity none", "go-none"), render(plain, false, "", "go-flat2"));
+    EXPECT_EQ(render(xml, false, "--gradient-opacity none", "go-none"),
+              render(plain, false, "", "go-flat2"));
     EXPECT_EQ(render(xml, false, "--gradient-opacity 5,50", "go-ramp"),
               render(plain, false, "--gradient-opacity 5,50", "go-ramp-explicit"));
 }
@@ -107,8 +110,8 @@ TEST(CliTfRendering, MipPresetsBlendByMaximumUnlessGiven) {
 }
 
 TEST(CliTfRendering, EveryBuiltInSlicerPresetLoadsAndRendersSomething) {
-    for (const char* name : {"CT-AAA", "CT-Bone", "CT-Lung", "CT-Soft-Tissue", "CT-MIP", "MR-Default",
-                             "MR-Angio", "MR-MIP"}) {
+    for (const char* name : {"CT-AAA", "CT-Bone", "CT-Lung", "CT-Soft-Tissue", "CT-MIP",
+                             "MR-Default", "MR-Angio", "MR-MIP"}) {
         const bool ct = std::string(name).starts_with("CT");
         const std::string png = (dir() / (std::string("preset-") + name + ".png")).string();
         const CliResult r =

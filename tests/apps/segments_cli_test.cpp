@@ -2,13 +2,13 @@
 // same PNG; bad label inputs give one line, exit code 2 and no output file.
 #include <gtest/gtest.h>
 
-#include "apps/cli_run.h"
-
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
-#include <algorithm>
+
+#include "apps/cli_run.h"
 
 namespace fs = std::filesystem;
 
@@ -36,7 +36,8 @@ TEST(SegmentsCli, OctreeAndUnskippedRendersWriteTheSamePngAndBadInputExits2) {
     ASSERT_EQ(lacuna("generate sphere-shells --dims 21x18x15 --out " + lab).code, 0);
     ASSERT_EQ(lacuna("generate sphere-shells --dims 20x18x15 --out " + other).code, 0);
     ASSERT_EQ(lacuna("generate sphere-shells --dims 21x18x15 --type float32 --out " + fl).code, 0);
-    for (const std::string& mode : std::vector<std::string>{"--labels " + lab + " --tf mr-default", "--segments labels"}) {
+    for (const std::string& mode :
+         std::vector<std::string>{"--labels " + lab + " --tf mr-default", "--segments labels"}) {
         const std::string base = (mode[2] == 's' ? lab : vol) + " " + mode +
                                  " --hide 1-40 --size 40 --azimuth 70 --out ";
         const CliResult a = lacuna("render " + base + (d / "a.png").string() + " --accel none");

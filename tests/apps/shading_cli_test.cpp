@@ -3,23 +3,29 @@
 // naming the flag, exit code 2, and no output file.
 #include <gtest/gtest.h>
 
-#include "apps/cli_run.h"
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "apps/cli_run.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
 using CliRun = lacuna::test::CliResult;
-std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
+std::string slurp(const fs::path& p) {
+    return lacuna::test::slurp_file(p);
+}
 
-fs::path temp_dir() { return lacuna::test::cli_temp_dir("shading-cli"); }
+fs::path temp_dir() {
+    return lacuna::test::cli_temp_dir("shading-cli");
+}
 
-CliRun run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliRun run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 const fs::path& volume() {
     static fs::path p = [] {
@@ -46,8 +52,9 @@ TEST(ShadingCli, EveryFeatureFlagRendersTheSameBytesForEveryAccel) {
         std::string first;
         for (const char* accel : {"none", "bitfield", "minmax", "distance", "kdtree"}) {
             const fs::path png = temp_dir() / (std::string("f-") + accel + ".png");
-            const CliRun r = run("render " + volume().string() + " --tf mr-default --size 40 --accel " +
-                                 accel + " --out " + png.string() + " " + set);
+            const CliRun r =
+                run("render " + volume().string() + " --tf mr-default --size 40 --accel " + accel +
+                    " --out " + png.string() + " " + set);
             ASSERT_EQ(r.code, 0) << set << ": " << r.err;
             EXPECT_NE(r.out.find("features:"), std::string::npos) << r.out;
             const std::string bytes = slurp(png);
@@ -61,8 +68,9 @@ TEST(ShadingCli, EveryFeatureFlagRendersTheSameBytesForEveryAccel) {
 
 TEST(ShadingCli, ReportsGradientAndLightVolumes) {
     const fs::path png = temp_dir() / "volumes.png";
-    const CliRun r = run("render " + volume().string() + " --tf mr-default --size 32 --out " + png.string() +
-                         " --shading pbr --gradient-volume --shadows --light-volume --light dir:0,1,0");
+    const CliRun r =
+        run("render " + volume().string() + " --tf mr-default --size 32 --out " + png.string() +
+            " --shading pbr --gradient-volume --shadows --light-volume --light dir:0,1,0");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("gradient volume: "), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("light volume: "), std::string::npos) << r.out;
@@ -90,8 +98,8 @@ TEST(ShadingCli, MalformedFeatureFlagsAreOneLineExit2) {
     for (const auto& [args, needle] : bad) {
         const fs::path png = temp_dir() / "bad.png";
         fs::remove(png);
-        const CliRun r = run("render " + volume().string() + " --tf mr-default --size 16 --out " + png.string() +
-                             " " + args);
+        const CliRun r = run("render " + volume().string() + " --tf mr-default --size 16 --out " +
+                             png.string() + " " + args);
         EXPECT_EQ(r.code, 2) << args << ": " << r.err;
         EXPECT_NE(r.err.find(needle), std::string::npos) << args << ": " << r.err;
         EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << args << ": more than one line: " << r.err;

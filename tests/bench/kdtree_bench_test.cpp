@@ -44,12 +44,10 @@ std::vector<uint8_t> holes_by_relaxation(const HoleMap& h) {
                 for (int i = 0; i < nx; ++i) {
                     const size_t c = at(i, j, k);
                     if (out[c] || h.cls[c] == 1) continue;
-                    const bool reach = (i > 0 && out[at(i - 1, j, k)]) ||
-                                       (i + 1 < nx && out[at(i + 1, j, k)]) ||
-                                       (j > 0 && out[at(i, j - 1, k)]) ||
-                                       (j + 1 < ny && out[at(i, j + 1, k)]) ||
-                                       (k > 0 && out[at(i, j, k - 1)]) ||
-                                       (k + 1 < nz && out[at(i, j, k + 1)]);
+                    const bool reach =
+                        (i > 0 && out[at(i - 1, j, k)]) || (i + 1 < nx && out[at(i + 1, j, k)]) ||
+                        (j > 0 && out[at(i, j - 1, k)]) || (j + 1 < ny && out[at(i, j + 1, k)]) ||
+                        (k > 0 && out[at(i, j, k - 1)]) || (k + 1 < nz && out[at(i, j, k + 1)]);
                     if (reach) out[c] = 1, changed = true;
                 }
     }

@@ -1,13 +1,12 @@
 // `lacuna bench li` in-process on a tiny synthetic dataset: every column is there, ESS and
 // ESS+M give the Basic bytes, ESS+CC stays within its threshold's bound, and Figure 6 has one
 // entry per frame of its orbit. No timing assertions (timings never gate tests).
-#include "bench/li.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "bench/datasets.h"
+#include "bench/li.h"
 #include "lacuna/synthetic.h"
 
 namespace lacuna::bench {

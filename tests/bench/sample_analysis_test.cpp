@@ -152,8 +152,8 @@ TEST(SampleAnalysis, TransparentTransferFunctionCountsZero) {
 
 // A plane of 255 at j = 10 in a volume of 0, seen orthographically along -y (azimuth 0,
 // elevation 0, the anterior view): the visible cells are j = 9 and j = 10, i.e. y in [9, 11),
-// which holds the lattice samples y = 10.75, 10.25, 9.75, 9.25 of every ray. With opacity 1 and ERT the first
-// of them (value 63.75, opaque) ends the ray.
+// which holds the lattice samples y = 10.75, 10.25, 9.75, 9.25 of every ray. With opacity 1 and ERT
+// the first of them (value 63.75, opaque) ends the ray.
 TEST(SampleAnalysis, HandBuiltPlaneCountsFourSamplesPerRay) {
     Volume v({6, 17, 6}, VoxelType::UInt8);
     for (int k = 0; k < 6; ++k)

@@ -61,13 +61,17 @@ inline Volume random_volume(Rng& rng, int max_dim) {
     const VoxelType type = VoxelType(rng.range(0, 3));
     Volume v(dims, type);
     const float hi = type == VoxelType::UInt8 ? 255.f : (type == VoxelType::Float32 ? 1.f : 4000.f);
-    auto value = [&] { return type == VoxelType::Float32 ? hi * rng.uniform() : std::floor(hi * rng.uniform()); };
+    auto value = [&] {
+        return type == VoxelType::Float32 ? hi * rng.uniform() : std::floor(hi * rng.uniform());
+    };
     const int points = rng.range(1, 60);
     for (int p = 0; p < points; ++p)
-        v.set_value(rng.range(0, dims.x - 1), rng.range(0, dims.y - 1), rng.range(0, dims.z - 1), value());
+        v.set_value(rng.range(0, dims.x - 1), rng.range(0, dims.y - 1), rng.range(0, dims.z - 1),
+                    value());
     const int blobs = rng.range(0, 3);
     for (int b = 0; b < blobs; ++b) {
-        const int cx = rng.range(0, dims.x - 1), cy = rng.range(0, dims.y - 1), cz = rng.range(0, dims.z - 1);
+        const int cx = rng.range(0, dims.x - 1), cy = rng.range(0, dims.y - 1),
+                  cz = rng.range(0, dims.z - 1);
         const int r = rng.range(1, 4);
         const float val = value();
         for (int z = std::max(0, cz - r); z <= std::min(dims.z - 1, cz + r); ++z)
@@ -96,7 +100,8 @@ struct KernelPaths {
     std::vector<simd::Isa> paths;
     simd::Isa saved = simd::active_isa();
     KernelPaths() {
-        for (simd::Isa i : {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
+        for (simd::Isa i :
+             {simd::Isa::Scalar, simd::Isa::Sse41, simd::Isa::Avx2, simd::Isa::Avx512})
             if (simd::isa_supported(i)) paths.push_back(i);
     }
     ~KernelPaths() { simd::set_isa(saved); }

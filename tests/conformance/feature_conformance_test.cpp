@@ -102,7 +102,8 @@ std::vector<FeatureCase> feature_cases() {
          }},
         // Piecewise-linear factors over |grad|: random points (with a step and zero stretches,
         // which must stay exactly zero), alone and with Phong as a shaded Slicer preset does.
-        {"gradient opacity points", [](FeatureOptions& f, const Volume& v, Rng& r) {
+        {"gradient opacity points",
+         [](FeatureOptions& f, const Volume& v, Rng& r) {
              f.gradient_opacity = random_gradient_points(v, r);
          }},
         {"gradient opacity points + phong",
@@ -149,7 +150,10 @@ std::vector<FeatureCase> feature_cases() {
                  f.crop_box.hi[a] = std::max(p, q) + 0.5f;
              }
          }},
-        {"two TFs", [](FeatureOptions& f, const Volume& v, Rng& r) { f.clip_planes.push_back(random_plane(v, r)); },
+        {"two TFs",
+         [](FeatureOptions& f, const Volume& v, Rng& r) {
+             f.clip_planes.push_back(random_plane(v, r));
+         },
          true},
         {"two TFs + clip + phong shadows",
          [](FeatureOptions& f, const Volume& v, Rng& r) {
@@ -170,7 +174,8 @@ std::vector<FeatureCase> feature_cases() {
              f.clip_planes.push_back(random_plane(v, r));
          },
          true},
-        {"jitter", [](FeatureOptions& f, const Volume&, Rng& r) {
+        {"jitter",
+         [](FeatureOptions& f, const Volume&, Rng& r) {
              f.jitter = true;
              f.jitter_seed = uint32_t(r.next());
          }},
@@ -213,7 +218,8 @@ void expect_exact(const std::string& name, const Volume& v, const TransferLut& f
                                  ref.rgba_float.size() * sizeof(float)))
             << name << " accel " << to_string(k) << ": float accumulations differ";
         ASSERT_LE(r.stats.samples, ref.stats.samples) << name << " accel " << to_string(k);
-        ASSERT_LE(r.stats.shadow_samples, ref.stats.shadow_samples) << name << " accel " << to_string(k);
+        ASSERT_LE(r.stats.shadow_samples, ref.stats.shadow_samples)
+            << name << " accel " << to_string(k);
     }
 }
 
@@ -224,8 +230,9 @@ TEST(FeatureConformance, EveryOptionIsExactForEveryStructure) {
         for (int trial = 0; trial < 4; ++trial) {
             const Volume v = test::random_volume(rng, 22);
             const ValueToLut map(v.vis_range(), kDefaultLutSize);
-            TransferLut front = trial % 2 == 0 ? test::spike_lut(v.vis_range(), map(v.value(0, 0, 0)))
-                                               : test::random_lut(v.vis_range(), rng);
+            TransferLut front = trial % 2 == 0
+                                    ? test::spike_lut(v.vis_range(), map(v.value(0, 0, 0)))
+                                    : test::random_lut(v.vis_range(), rng);
             if (trial % 2 == 0) front.entries[size_t(map(v.data_range().max * 0.5f))].a = 0.5f;
             const TransferLut back_lut = test::random_lut(v.vis_range(), rng);
             AccelOptions ao;
@@ -246,10 +253,10 @@ TEST(FeatureConformance, EveryOptionIsExactForEveryStructure) {
 
 // Every kernel path this CPU runs (core/simd_lanes.h: the scalar path is feature::composite_ray,
 // one sample at a time; SSE4.1, AVX2 and AVX-512 run the batched ShadedStream with the lanes of
-// core/simd_shading.h, and on a refined grid AVX2/AVX-512 the leaping shaded lanes) gives the bytes, float accumulations and per-pixel sample counts of the
-// scalar --accel none render, for every feature option and structure, with and without early
-// termination. Half the trials use a dense LUT (every entry different, so a value one ulp off
-// lands in another entry and shows).
+// core/simd_shading.h, and on a refined grid AVX2/AVX-512 the leaping shaded lanes) gives the
+// bytes, float accumulations and per-pixel sample counts of the scalar --accel none render, for
+// every feature option and structure, with and without early termination. Half the trials use a
+// dense LUT (every entry different, so a value one ulp off lands in another entry and shows).
 TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
     const test::KernelPaths kp;
     const std::vector<simd::Isa>& paths = kp.paths;
@@ -288,22 +295,23 @@ TEST(FeatureConformance, EveryShadingPathIsExactForEveryStructure) {
                 // Each structure as the TF change leaves it, then refined (the grid's
                 // visible-cell mask skips whole lattice batches on the SIMD paths).
                 for (int refined = 0; refined < 2; ++refined)
-                for (simd::Isa isa : paths) {
-                    if (refined && isa == paths.front()) accel->refine();
-                    simd::set_isa(isa);
-                    const RenderResult r = ma.render(cam, o);
-                    const std::string what = std::string(fc.name) + " trial " + std::to_string(trial) +
-                                             " " + to_string(v.type()) + " accel " + to_string(k) +
-                                             " path " + simd::to_string(isa) +
-                                             (refined ? " refined" : "");
-                    ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
-                    ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
-                                             ref.rgba_float.size() * sizeof(float)))
-                        << what << ": float accumulations differ";
-                    if (k == AccelKind::None) ASSERT_EQ(r.sample_counts, ref.sample_counts) << what;
-                    ASSERT_LE(r.stats.samples, ref.stats.samples) << what;
-                    ++compared;
-                }
+                    for (simd::Isa isa : paths) {
+                        if (refined && isa == paths.front()) accel->refine();
+                        simd::set_isa(isa);
+                        const RenderResult r = ma.render(cam, o);
+                        const std::string what = std::string(fc.name) + " trial " +
+                                                 std::to_string(trial) + " " + to_string(v.type()) +
+                                                 " accel " + to_string(k) + " path " +
+                                                 simd::to_string(isa) + (refined ? " refined" : "");
+                        ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
+                        ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
+                                                 ref.rgba_float.size() * sizeof(float)))
+                            << what << ": float accumulations differ";
+                        if (k == AccelKind::None)
+                            ASSERT_EQ(r.sample_counts, ref.sample_counts) << what;
+                        ASSERT_LE(r.stats.samples, ref.stats.samples) << what;
+                        ++compared;
+                    }
             }
         }
     }
@@ -323,7 +331,8 @@ TEST(FeatureConformance, ShadedLeapingLanesAreExactOnSparseVolumes) {
         const ValueToLut map = lut.map();
         // The background (the volume's minimum, most voxels) and a band above it transparent.
         const int band = map(v.data_range().min) + rng.range(0, 40);
-        for (int e = 0; e <= std::min(band, int(lut.entries.size()) - 1); ++e) lut.entries[size_t(e)].a = 0.f;
+        for (int e = 0; e <= std::min(band, int(lut.entries.size()) - 1); ++e)
+            lut.entries[size_t(e)].a = 0.f;
         if (trial % 3 == 1) test::make_dense(lut, size_t(1) << 14, rng), lut.entries[0].a = 0.f;
         RenderOptions o;
         o.keep_float = true;
@@ -367,11 +376,13 @@ TEST(FeatureConformance, AcceleratedShadowRaysEqualUnacceleratedOnes) {
         ro.keep_float = true;
         ro.ert = trial % 2 ? 0.9f : kNoEarlyTermination;
         ro.features.shading = ShadingModel::Phong;
-        ro.features.light = random_light(v, rng, trial % 3 == 0 ? LightKind::Spot : LightKind::Directional);
+        ro.features.light =
+            random_light(v, rng, trial % 3 == 0 ? LightKind::Spot : LightKind::Directional);
         ro.features.shadows.enabled = true;
         ro.features.shadows.light_volume = trial >= 4;
         const Camera cam = test::random_camera(v, rng, 24);
-        for (AccelKind k : {AccelKind::Bitfield, AccelKind::MinMax, AccelKind::Distance, AccelKind::KdTree}) {
+        for (AccelKind k :
+             {AccelKind::Bitfield, AccelKind::MinMax, AccelKind::Distance, AccelKind::KdTree}) {
             auto accel = make_accel(k, v);
             accel->set_transfer_function(lut);
             RayMarcher a(v), b(v);
@@ -400,7 +411,8 @@ TEST(FeatureConformance, MipSkipsSamplesWithValueStructures) {
     for (int z = 0; z < 48; ++z)
         for (int y = 0; y < 48; ++y)
             for (int x = 0; x < 48; ++x)
-                if (x == 0 || y == 0 || z == 0 || x == 47 || y == 47 || z == 47) v.set_value(x, y, z, 200.f);
+                if (x == 0 || y == 0 || z == 0 || x == 47 || y == 47 || z == 47)
+                    v.set_value(x, y, z, 200.f);
     v.set_value(0, 0, 0, 255.f);
     v.compute_range();
     TransferLut lut;

@@ -91,7 +91,8 @@ TEST(Nearest, EveryKernelPathMarchesTheNearestVoxel) {
         for (simd::Isa isa : kp.paths) {
             simd::set_isa(isa);
             ASSERT_TRUE(same_floats(m.render(cam, o).rgba_float, ref))
-                << "trial " << trial << " " << to_string(v.type()) << " path " << simd::to_string(isa);
+                << "trial " << trial << " " << to_string(v.type()) << " path "
+                << simd::to_string(isa);
             ++compared;
         }
         // The test would notice trilinear samples: on most trials they give other floats.
@@ -141,7 +142,8 @@ TEST(Nearest, EveryStructureAndKernelPathIsExact) {
                                              " built for " + to_string(built) + " path " +
                                              simd::to_string(isa);
                     ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
-                    ASSERT_TRUE(same_floats(r.rgba_float, ref.rgba_float)) << what << ": floats differ";
+                    ASSERT_TRUE(same_floats(r.rgba_float, ref.rgba_float))
+                        << what << ": floats differ";
                     ASSERT_LE(r.stats.samples, ref.stats.samples) << what;
                     ++compared;
                 }

@@ -24,9 +24,9 @@
 namespace lacuna {
 namespace {
 
-using test::Rng;
 using test::random_camera;
 using test::random_lut;
+using test::Rng;
 using test::spike_lut;
 
 struct Case {
@@ -60,8 +60,9 @@ void expect_all_structures_exact(const Case& c, std::vector<AccelKind> kinds = a
             m.set_accel(accel.get());
             const RenderResult r = m.render(c.camera, o);
             m.set_accel(nullptr);
-            const std::string what = c.name + " accel " + to_string(k) +
-                                     (refined ? " refined, path " + simd::to_string(kp.paths[pass - 1]) : "");
+            const std::string what =
+                c.name + " accel " + to_string(k) +
+                (refined ? " refined, path " + simd::to_string(kp.paths[pass - 1]) : "");
             ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
             ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
                                      ref.rgba_float.size() * sizeof(float)))
@@ -72,9 +73,9 @@ void expect_all_structures_exact(const Case& c, std::vector<AccelKind> kinds = a
 }
 
 TEST(Conformance, AdversarialSyntheticVolumesAreExactForEveryStructure) {
-    const SyntheticKind kinds[] = {SyntheticKind::ThinSheets, SyntheticKind::Checkerboard,
+    const SyntheticKind kinds[] = {SyntheticKind::ThinSheets,    SyntheticKind::Checkerboard,
                                    SyntheticKind::BinBoundaries, SyntheticKind::Tree,
-                                   SyntheticKind::SphereShells, SyntheticKind::NoiseBlobs,
+                                   SyntheticKind::SphereShells,  SyntheticKind::NoiseBlobs,
                                    SyntheticKind::MarschnerLobb};
     const VoxelType types[] = {VoxelType::UInt8, VoxelType::Int16, VoxelType::UInt16,
                                VoxelType::Float32};
@@ -92,15 +93,21 @@ TEST(Conformance, AdversarialSyntheticVolumesAreExactForEveryStructure) {
             const int entries[] = {map(v.data_range().max), map(v.data_range().min) + 1,
                                    map(0.5f * (v.data_range().min + v.data_range().max))};
             for (int e : entries) {
-                Case c{to_string(kind) + "/" + to_string(type) + "/spike" + std::to_string(e), &v,
+                Case c{to_string(kind) + "/" + to_string(type) + "/spike" + std::to_string(e),
+                       &v,
                        spike_lut(v.vis_range(), std::min(e, kDefaultLutSize - 1)),
-                       random_camera(v, rng, 40), RenderOptions{}, AccelOptions{}};
+                       random_camera(v, rng, 40),
+                       RenderOptions{},
+                       AccelOptions{}};
                 c.options.ert = rng.range(0, 1) ? 0.99f : 2.f;
                 c.options.step = 0.2f + rng.uniform();
                 expect_all_structures_exact(c);
             }
-            Case c{to_string(kind) + "/" + to_string(type) + "/random", &v,
-                   random_lut(v.vis_range(), rng), random_camera(v, rng, 40), RenderOptions{},
+            Case c{to_string(kind) + "/" + to_string(type) + "/random",
+                   &v,
+                   random_lut(v.vis_range(), rng),
+                   random_camera(v, rng, 40),
+                   RenderOptions{},
                    AccelOptions{}};
             expect_all_structures_exact(c);
         }
@@ -113,13 +120,14 @@ TEST(Conformance, RandomVolumesTfsAndCamerasAreExact) {
         const VoxelType type = VoxelType(rng.range(0, 3));
         Volume v(dims, type);
         // Sparse random content: mostly the minimum, a few random-valued voxels and blobs.
-        const float hi = type == VoxelType::UInt8 ? 255.f : (type == VoxelType::Float32 ? 1.f : 4000.f);
+        const float hi =
+            type == VoxelType::UInt8 ? 255.f : (type == VoxelType::Float32 ? 1.f : 4000.f);
         const int points = rng.range(1, 60);
         for (int p = 0; p < points; ++p) {
             const int x = rng.range(0, dims.x - 1), y = rng.range(0, dims.y - 1),
                       z = rng.range(0, dims.z - 1);
-            const float val = type == VoxelType::Float32 ? hi * rng.uniform()
-                                                         : std::floor(hi * rng.uniform());
+            const float val =
+                type == VoxelType::Float32 ? hi * rng.uniform() : std::floor(hi * rng.uniform());
             v.set_value(x, y, z, val);
         }
         v.set_value(0, 0, 0, hi);  // a known range
@@ -139,8 +147,12 @@ TEST(Conformance, RandomVolumesTfsAndCamerasAreExact) {
         } else {
             lut = random_lut(v.vis_range(), rng);
         }
-        Case c{"random trial " + std::to_string(trial), &v, lut, random_camera(v, rng, 32),
-               RenderOptions{}, ao};
+        Case c{"random trial " + std::to_string(trial),
+               &v,
+               lut,
+               random_camera(v, rng, 32),
+               RenderOptions{},
+               ao};
         c.options.step = 0.1f + 1.5f * rng.uniform();
         c.options.ert = rng.range(0, 1) ? 0.9f : 2.f;
         expect_all_structures_exact(c);
@@ -163,8 +175,12 @@ TEST(Conformance, RealDatasetsAreExactForEveryStructure) {
         const Volume v = read_volume(dir + r.file);
         const TransferLut lut = discretise(preset(r.preset), v.vis_range());
         for (int view = 0; view < 2; ++view) {
-            Case c{std::string(r.file) + "/" + r.preset + "/view" + std::to_string(view), &v, lut,
-                   random_camera(v, rng, 48), RenderOptions{}, AccelOptions{}};
+            Case c{std::string(r.file) + "/" + r.preset + "/view" + std::to_string(view),
+                   &v,
+                   lut,
+                   random_camera(v, rng, 48),
+                   RenderOptions{},
+                   AccelOptions{}};
             c.options.ert = view == 0 ? 0.99f : 2.f;
             expect_all_structures_exact(c);
         }
@@ -188,9 +204,13 @@ TEST(Conformance, EveryOctreeSettingIsExact) {
                 ao.bidirectional = (leaf + bits + level) % 2 == 0;
                 Case c{"leaf " + std::to_string(leaf) + " bits " + std::to_string(bits) +
                            " level " + std::to_string(level),
-                       &v, lut, cam, RenderOptions{}, ao};
-                expect_all_structures_exact(c, {AccelKind::Bitfield, AccelKind::MinMax,
-                                                AccelKind::Boolean});
+                       &v,
+                       lut,
+                       cam,
+                       RenderOptions{},
+                       ao};
+                expect_all_structures_exact(
+                    c, {AccelKind::Bitfield, AccelKind::MinMax, AccelKind::Boolean});
             }
 }
 
@@ -245,20 +265,21 @@ TEST(Conformance, EveryKernelPathIsExactForEveryStructure) {
             accel->set_transfer_function(lut);
             m.set_accel(accel.get());
             for (int refined = 0; refined < 2; ++refined)
-            for (simd::Isa isa : paths) {
-                if (refined && isa == paths.front()) accel->refine();
-                simd::set_isa(isa);
-                const RenderResult r = m.render(cam, o);
-                const std::string what = "trial " + std::to_string(trial) + " " +
-                                         to_string(v.type()) + " accel " + to_string(k) +
-                                         " path " + simd::to_string(isa) + (refined ? " refined" : "");
-                ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
-                ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
-                                         ref.rgba_float.size() * sizeof(float)))
-                    << what << ": float accumulations differ";
-                if (k == AccelKind::None) ASSERT_EQ(r.sample_counts, ref.sample_counts) << what;
-                ++compared;
-            }
+                for (simd::Isa isa : paths) {
+                    if (refined && isa == paths.front()) accel->refine();
+                    simd::set_isa(isa);
+                    const RenderResult r = m.render(cam, o);
+                    const std::string what = "trial " + std::to_string(trial) + " " +
+                                             to_string(v.type()) + " accel " + to_string(k) +
+                                             " path " + simd::to_string(isa) +
+                                             (refined ? " refined" : "");
+                    ASSERT_EQ(r.image.rgba, ref.image.rgba) << what;
+                    ASSERT_EQ(0, std::memcmp(r.rgba_float.data(), ref.rgba_float.data(),
+                                             ref.rgba_float.size() * sizeof(float)))
+                        << what << ": float accumulations differ";
+                    if (k == AccelKind::None) ASSERT_EQ(r.sample_counts, ref.sample_counts) << what;
+                    ++compared;
+                }
             m.set_accel(nullptr);
         }
     }

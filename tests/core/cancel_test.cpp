@@ -1,11 +1,12 @@
 // core/cancel.h: a CancelScope's flag stops parallel_for_tiles between tiles (the viewer's
 // frame cancellation); without a scope, or with the flag clear, every tile runs.
+#include "core/cancel.h"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <thread>
 
-#include "core/cancel.h"
 #include "core/parallel.h"
 
 namespace {

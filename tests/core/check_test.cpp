@@ -24,7 +24,8 @@ TEST(Check, APassingCheckDoesNothing) {
 TEST(CheckDeathTest, AFailedCheckPrintsTheConditionAndBothOperandsAndAborts) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");
     const int cells = 3;
-    EXPECT_DEATH(LACUNA_CHECK_EQ(cells, 4), "CHECK failed at .*check_test\\.cpp:[0-9]+: cells == 4 \\(3 vs 4\\)");
+    EXPECT_DEATH(LACUNA_CHECK_EQ(cells, 4),
+                 "CHECK failed at .*check_test\\.cpp:[0-9]+: cells == 4 \\(3 vs 4\\)");
     EXPECT_DEATH(LACUNA_CHECK_LT(2.5, 1.0), "2\\.5 < 1\\.0 \\(2\\.5 vs 1\\)");
     EXPECT_DEATH(LACUNA_CHECK(cells > 5), "CHECK failed at .*: cells > 5");
 }

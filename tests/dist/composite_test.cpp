@@ -1,8 +1,9 @@
 // src/dist/composite.h without messages: rectangles, over, and radix-k's block order.
+#include "dist/composite.h"
+
 #include <gtest/gtest.h>
 
 #include "common/rng.h"
-#include "dist/composite.h"
 
 namespace lacuna::dist {
 namespace {
@@ -31,7 +32,8 @@ TEST(Composite, OverOfPartialChainsIsTheChain) {
         const int n = rng.range(1, 30), m = rng.range(0, n);
         float chain[4] = {0, 0, 0, 0}, front[4] = {0, 0, 0, 0}, back[4] = {0, 0, 0, 0};
         for (int s = 0; s < n; ++s) {
-            const float a = rng.uniform() * 0.3f, c[3] = {rng.uniform() * a, rng.uniform() * a, rng.uniform() * a};
+            const float a = rng.uniform() * 0.3f,
+                        c[3] = {rng.uniform() * a, rng.uniform() * a, rng.uniform() * a};
             for (float* acc : {chain, s < m ? front : back}) {
                 const float w = 1.f - acc[3];
                 for (int ch = 0; ch < 3; ++ch) acc[ch] += w * c[ch];
@@ -53,10 +55,12 @@ TEST(Composite, BlockOrderIsTheVisibilityOrderOfTheSubtree) {
     for (int n : {2, 4, 8, 16}) {
         const Decomposition d = decompose_voxels({40, 33, 29}, n);
         for (int it = 0; it < 20; ++it) {
-            const Vec3f eye{-20.f + 80.f * rng.uniform(), -20.f + 70.f * rng.uniform(), -20.f + 70.f * rng.uniform()};
+            const Vec3f eye{-20.f + 80.f * rng.uniform(), -20.f + 70.f * rng.uniform(),
+                            -20.f + 70.f * rng.uniform()};
             const Vec3f dir{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f};
             const bool ortho = it % 2 == 0;
-            EXPECT_EQ(block_order(d, 0, n, 1, eye, dir, ortho), visibility_order(d, eye, dir, ortho));
+            EXPECT_EQ(block_order(d, 0, n, 1, eye, dir, ortho),
+                      visibility_order(d, eye, dir, ortho));
             if (n >= 4) {
                 // Blocks of 2: the order of the pairs, each pair's ranks together.
                 const std::vector<int> pairs = block_order(d, 0, n, 2, eye, dir, ortho);

@@ -1,8 +1,7 @@
 // Helpers for the io tests: scratch directories, file bytes, small synthetic volumes.
 #pragma once
-#include <sys/wait.h>
-#include <unistd.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>

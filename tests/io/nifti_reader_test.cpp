@@ -124,7 +124,8 @@ TEST(IoNifti, ReadsTheChosenVolumeOfAFourDimensionalFile) {
                 const Volume v = read_volume(dir.file(name), ro);
                 ASSERT_EQ(v.dims(), (Vec3i{3, 2, 2})) << name;
                 for (int i = 0; i < 12; ++i)
-                    ASSERT_EQ(v.data_as<uint16_t>()[i], vox[size_t(12 * frame + i)]) << name << " " << frame;
+                    ASSERT_EQ(v.data_as<uint16_t>()[i], vox[size_t(12 * frame + i)])
+                        << name << " " << frame;
             }
             for (const int64_t bad : {int64_t(3), int64_t(-1), int64_t(1) << 40}) {
                 ReadOptions ro;
@@ -141,9 +142,11 @@ TEST(IoNifti, ReadsTheChosenVolumeOfAFourDimensionalFile) {
                 ro.frame = 1;
                 EXPECT_EQ(read_volume(dir.file("cut" + name), ro).data_as<uint16_t>()[0], 1001);
                 ro.frame = 2;
-                const std::string msg = test::error_of([&] { read_volume(dir.file("cut" + name), ro); });
-                EXPECT_NE(msg.find("voxel data: truncated: expected 24 bytes of voxels after offset"),
-                          std::string::npos)
+                const std::string msg =
+                    test::error_of([&] { read_volume(dir.file("cut" + name), ro); });
+                EXPECT_NE(
+                    msg.find("voxel data: truncated: expected 24 bytes of voxels after offset"),
+                    std::string::npos)
                     << msg;
                 EXPECT_NE(msg.find("(volume 2), the file has 12"), std::string::npos) << msg;
             }
@@ -187,19 +190,25 @@ TEST(IoNifti, ReadsTwoFilePairsAsTheirOneFileNii) {
             const Volume ref = read_volume(dir.file("one" + v + ".nii"), ro);
             for (const char* name : {"pair", "gz"})
                 for (const char* ext : {".hdr", ".img"}) {
-                    const std::string file = dir.file(name + v + (ext == std::string(".img") && name == std::string("gz") ? ".img.gz" : ext));
+                    const std::string file = dir.file(
+                        name + v +
+                        (ext == std::string(".img") && name == std::string("gz") ? ".img.gz"
+                                                                                 : ext));
                     const Volume got = read_volume(file, ro);
                     ASSERT_EQ(got.dims(), ref.dims()) << file;
-                    EXPECT_EQ(0, std::memcmp(got.data(), ref.data(), 24 * 2)) << file << " frame " << frame;
+                    EXPECT_EQ(0, std::memcmp(got.data(), ref.data(), 24 * 2))
+                        << file << " frame " << frame;
                     EXPECT_EQ(to_string(got.spacing), to_string(ref.spacing)) << file;
                     EXPECT_EQ(to_string(got.origin), to_string(ref.origin)) << file;
-                    for (int i = 0; i < 9; ++i) EXPECT_EQ(got.direction[i], ref.direction[i]) << file;
+                    for (int i = 0; i < 9; ++i)
+                        EXPECT_EQ(got.direction[i], ref.direction[i]) << file;
                 }
         }
         ReadOptions ro;
         ro.frame = 1;
         test::write_bytes(dir.file("short" + v + ".hdr"), hdr);
-        test::write_bytes(dir.file("short" + v + ".img"), std::vector<uint8_t>(img.begin(), img.end() - 2));
+        test::write_bytes(dir.file("short" + v + ".img"),
+                          std::vector<uint8_t>(img.begin(), img.end() - 2));
         std::string msg = test::error_of([&] { read_volume(dir.file("short" + v + ".hdr"), ro); });
         EXPECT_NE(msg.find("short" + v + ".img: voxel data: truncated"), std::string::npos) << msg;
         test::write_bytes(dir.file("lonely" + v + ".hdr"), hdr);
@@ -207,7 +216,9 @@ TEST(IoNifti, ReadsTwoFilePairsAsTheirOneFileNii) {
         EXPECT_NE(msg.find("lonely" + v + ".img: file: does not exist"), std::string::npos) << msg;
         test::write_bytes(dir.file("wrong" + v + ".nii"), test::nifti_bytes(spec, vox.data(), 96));
         msg = test::error_of([&] { read_volume(dir.file("wrong" + v + ".nii"), ro); });
-        EXPECT_NE(msg.find("the header says its voxels are in a separate .img file"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("the header says its voxels are in a separate .img file"),
+                  std::string::npos)
+            << msg;
     }
     NiftiSpec analyze;
     analyze.magic = std::string("\0\0\0\0", 4);
@@ -217,8 +228,10 @@ TEST(IoNifti, ReadsTwoFilePairsAsTheirOneFileNii) {
     test::write_bytes(dir.file("analyze.hdr"), hdr);
     test::write_bytes(dir.file("analyze.img"), std::vector<uint8_t>(24, 1));
     const std::string msg = test::error_of([&] { read_volume(dir.file("analyze.hdr")); });
-    EXPECT_NE(msg.find("analyze.hdr: header: not a NIfTI-1 pair header (magic 'ni1' missing; Analyze 7.5"),
-              std::string::npos)
+    EXPECT_NE(
+        msg.find(
+            "analyze.hdr: header: not a NIfTI-1 pair header (magic 'ni1' missing; Analyze 7.5"),
+        std::string::npos)
         << msg;
 }
 
@@ -232,13 +245,15 @@ TEST(IoNifti, AThreeDimensionalFileHasOneFrame) {
     ro.frame = 0;
     EXPECT_EQ(read_volume(dir.file("one.nii"), ro).data_as<uint8_t>()[7], 8);
     ro.frame = 1;
-    EXPECT_NE(test::error_of([&] { read_volume(dir.file("one.nii"), ro); })
-                  .find("one.nii: frame: expected 0..0 (the file holds one volume), got 1"),
+    EXPECT_NE(test::error_of([&] {
+                  read_volume(dir.file("one.nii"), ro);
+              }).find("one.nii: frame: expected 0..0 (the file holds one volume), got 1"),
               std::string::npos);
     const Volume v = read_volume(dir.file("one.nii"));
     write_volume(dir.file("one.nrrd"), v);
-    EXPECT_NE(test::error_of([&] { read_volume(dir.file("one.nrrd"), ro); })
-                  .find("one.nrrd: frame: expected 0: this format is read as one volume"),
+    EXPECT_NE(test::error_of([&] {
+                  read_volume(dir.file("one.nrrd"), ro);
+              }).find("one.nrrd: frame: expected 0: this format is read as one volume"),
               std::string::npos);
     ro.frame = 0;
     EXPECT_EQ(read_volume(dir.file("one.nrrd"), ro).dims(), v.dims());

@@ -240,22 +240,25 @@ TEST(IoBudget, CliRefusesA30000CubedClaimInOneLineAndWritesNothing) {
     const std::vector<std::pair<std::string, std::string>> files{
         {"claim.nii.gz", std::string(gz.begin(), gz.end())},
         {"claim.nii", std::string(nii.begin(), nii.end())},
-        {"claim.nrrd", "NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 30000\n"
-                       "endian: little\nencoding: raw\n\n" + tail},
-        {"claim.mha", "ObjectType = Image\nNDims = 3\nDimSize = 30000 30000 30000\n"
-                      "ElementType = MET_SHORT\nElementDataFile = LOCAL\n" + tail},
+        {"claim.nrrd",
+         "NRRD0004\ntype: short\ndimension: 3\nsizes: 30000 30000 30000\n"
+         "endian: little\nencoding: raw\n\n" +
+             tail},
+        {"claim.mha",
+         "ObjectType = Image\nNDims = 3\nDimSize = 30000 30000 30000\n"
+         "ElementType = MET_SHORT\nElementDataFile = LOCAL\n" +
+             tail},
     };
     for (const auto& [name, bytes] : files) {
         SCOPED_TRACE(name);
         const std::string path = dir.file(name);
         test::write_text(path, bytes);
         for (const std::string& cmd :
-             {"info " + path, "render " + path + " --tf mr-default --size 16 --out " +
-                                  out.file("frame.png")}) {
+             {"info " + path,
+              "render " + path + " --tf mr-default --size 16 --out " + out.file("frame.png")}) {
             const auto r = test::run_cli(cmd, out.path());
             test::expect_one_line_error(r, name + ": dims: 30000x30000x30000");
-            EXPECT_EQ(out.names(), (std::vector<std::string>{"stderr.txt", "stdout.txt"}))
-                << cmd;
+            EXPECT_EQ(out.names(), (std::vector<std::string>{"stderr.txt", "stdout.txt"})) << cmd;
             EXPECT_EQ(dir.names(), std::vector<std::string>{name}) << cmd;
             const std::vector<uint8_t> now = test::file_bytes(path);
             EXPECT_EQ(std::string(now.begin(), now.end()), bytes) << cmd;
@@ -338,8 +341,7 @@ TEST(IoMetaImage, HeaderEndsOnlyWhereMetaIOEndsIt) {
               std::string::npos)
         << msg;
     // Spelt as MetaIO spells it, the key ends the header: what follows is voxels, not checked.
-    test::write_text(dir.file("ok.mha"), head + "ElementDataFile = LOCAL\n" +
-                                             std::string(8, 'K'));
+    test::write_text(dir.file("ok.mha"), head + "ElementDataFile = LOCAL\n" + std::string(8, 'K'));
     EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
 }
 
@@ -679,8 +681,8 @@ TEST(IoDicomFolder, HugeLengthInAFileWithoutPreambleIsAnError) {
          {0x08, 0, 0x16, 0, 0xff, 0xff, 0xff, 0x7f, 1, 2},
          "element (0008,0016) says 2147483647 bytes, 2 are left"},
         {"group 0008, explicit VR, after a good element",
-         {0x08, 0, 0x05, 0, 'C', 'S', 2, 0, 'I', 'R', 0x08, 0, 0x06, 0, 'U', 'N', 0, 0, 0, 0,
-          0, 0x80},
+         {0x08, 0,    0x05, 0,   'C', 'S', 2, 0, 'I', 'R', 0x08,
+          0,    0x06, 0,    'U', 'N', 0,   0, 0, 0,   0,   0x80},
          "element (0008,0006) says 2147483648 bytes, 0 are left"},
         {"ACR-NEMA big endian, explicit VR",
          {0, 0x08, 0, 0x16, 'O', 'W', 0, 0, 0x40, 0, 0, 0, 9, 9},
@@ -689,8 +691,8 @@ TEST(IoDicomFolder, HugeLengthInAFileWithoutPreambleIsAnError) {
          {0x09, 0, 0x10, 0, 0, 0, 0, 0x60, 'x', 'y'},
          "element (0009,0010) says 1610612736 bytes, 2 are left"},
         {"a private creator first, explicit VR (GDCM 3.0.21 looks for a VR here too)",
-         {0x09, 0, 0x10, 0, 'L', 'O', 4, 0, 'A', 'C', 'M', 'E', 0x09, 0, 0x11, 0, 'O', 'B', 0, 0,
-          0, 0, 0, 0x50},
+         {0x09, 0, 0x10, 0, 'L', 'O', 4, 0, 'A', 'C', 'M', 'E',
+          0x09, 0, 0x11, 0, 'O', 'B', 0, 0, 0,   0,   0,   0x50},
          "element (0009,0011) says 1342177280 bytes, 0 are left"},
     };
     for (const Case& c : cases) {
@@ -761,7 +763,8 @@ TEST(IoDicomFolder, ADataSetOpeningWithElement0000IsGuessedAsGdcmGuessesIt) {
         {"then an implicit element whose length runs past the end: walked from byte 0",
          after_null({0x08, 0, 0x16, 0, 0xff, 0xff, 0xff, 0x7f, 1, 2}),
          "element (0008,0016) says 2147483647 bytes, 2 are left"},
-        {"its own value cut short", {0, 0, 0, 0, 4, 0, 0, 0, 1, 2},
+        {"its own value cut short",
+         {0, 0, 0, 0, 4, 0, 0, 0, 1, 2},
          "element (0000,0000) says 4 bytes, 2 are left"},
     };
     for (const Case& c : refused) {
@@ -790,8 +793,9 @@ TEST(IoDicomFolder, ADataSetOpeningWithElement0000IsGuessedAsGdcmGuessesIt) {
             const io::DicomWalk w = io::walk_dicom_bytes(b.data(), b.size(), "junk", s);
             EXPECT_TRUE(w.dicom && w.checked) << nulls;
         } else {
-            EXPECT_NE(test::error_of([&] { io::walk_dicom_bytes(b.data(), b.size(), "junk", s); })
-                          .find("junk: starts with more than 16 elements (0000,0000)"),
+            EXPECT_NE(test::error_of([&] {
+                          io::walk_dicom_bytes(b.data(), b.size(), "junk", s);
+                      }).find("junk: starts with more than 16 elements (0000,0000)"),
                       std::string::npos);
         }
     }

@@ -1,6 +1,6 @@
-#include <gtest/gtest.h>
-
 #include "lacuna/camera.h"
+
+#include <gtest/gtest.h>
 
 namespace lacuna {
 namespace {

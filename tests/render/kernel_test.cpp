@@ -19,9 +19,9 @@ using namespace accel_test;
 template <class T, class Index>
 kernel::Grid<T, Index> grid_of(const Volume& v) {
     const Vec3i d = v.dims();
-    return kernel::Grid<T, Index>{v.data_as<T>(),     ptrdiff_t(d.x), ptrdiff_t(d.x) * d.y,
-                                  float(d.x - 1),     float(d.y - 1), float(d.z - 1),
-                                  d.x - 2,            d.y - 2,        d.z - 2};
+    return kernel::Grid<T, Index>{v.data_as<T>(), ptrdiff_t(d.x), ptrdiff_t(d.x) * d.y,
+                                  float(d.x - 1), float(d.y - 1), float(d.z - 1),
+                                  d.x - 2,        d.y - 2,        d.z - 2};
 }
 
 uint32_t bits(float f) {
@@ -50,7 +50,8 @@ void check_volume(const Volume& v, const TransferLut& lut, Rng& rng, const std::
             len += c * c;
         }
         if (len == 0.f) dir[0] = len = 1.f;
-        r.dx = dir[0] / std::sqrt(len), r.dy = dir[1] / std::sqrt(len), r.dz = dir[2] / std::sqrt(len);
+        r.dx = dir[0] / std::sqrt(len), r.dy = dir[1] / std::sqrt(len),
+        r.dz = dir[2] / std::sqrt(len);
         const float dt = 0.1f + rng.uniform();
         const float t_base = rng.uniform() * 3.f - 1.f;
         const int k_end = rng.range(1, 120);
@@ -70,10 +71,10 @@ void check_volume(const Volume& v, const TransferLut& lut, Rng& rng, const std::
             uint32_t n = 0;
             for (int k = 0; k < k_end;) {
                 const int k1 = std::min(k_end, k + rng.range(1, 40));
-                n += variant == 0 ? kernel::march(g32, r, t_base, dt, k, k1, table.data(), map,
-                                                  2.f, acc, done)
-                                  : kernel::march(g64, r, t_base, dt, k, k1, table.data(), map,
-                                                  2.f, acc, done);
+                n += variant == 0 ? kernel::march(g32, r, t_base, dt, k, k1, table.data(), map, 2.f,
+                                                  acc, done)
+                                  : kernel::march(g64, r, t_base, dt, k, k1, table.data(), map, 2.f,
+                                                  acc, done);
                 k = k1;
             }
             const char* idx = variant == 0 ? "int32 offsets" : "int64 offsets";
@@ -99,8 +100,8 @@ void check_volume(const Volume& v, const TransferLut& lut, Rng& rng, const std::
             for (auto [k0, k1] : runs)
                 for (int k = k0; k < k1 && !stop; ++k) {
                     const float t = t_base + (float(k) + 0.5f) * dt;
-                    const Rgba& c = table[size_t(map(
-                        kernel::trilinear(g32, r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz)))];
+                    const Rgba& c = table[size_t(map(kernel::trilinear(
+                        g32, r.ox + t * r.dx, r.oy + t * r.dy, r.oz + t * r.dz)))];
                     const float w = 1.f - want.a;
                     want.r += w * c.r, want.g += w * c.g, want.b += w * c.b, want.a += w * c.a;
                     ++want_n;
@@ -115,7 +116,10 @@ void check_volume(const Volume& v, const TransferLut& lut, Rng& rng, const std::
                 s.finish();
                 n = s.samples();
             };
-            if (variant % 2 == 0) run_stream(g32); else run_stream(g64);
+            if (variant % 2 == 0)
+                run_stream(g32);
+            else
+                run_stream(g64);
             const std::string idx = std::string(variant % 2 == 0 ? "int32" : "int64") +
                                     " stream, ert " + std::to_string(ert);
             ASSERT_EQ(n, want_n) << what << ", " << idx << ", ray " << ray;

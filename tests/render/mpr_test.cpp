@@ -2,13 +2,14 @@
 // index this file computes from the geometry by its own route (R^T (w - t) / spacing), the
 // display convention on an unrotated volume voxel by voxel, linear ramps, one phantom in three
 // voxel orders, and the probe against brute force.
+#include "lacuna/mpr.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "common/rng.h"
 #include "lacuna/error.h"
-#include "lacuna/mpr.h"
 #include "lacuna/orientation.h"
 #include "render/orientation_test_util.h"
 
@@ -78,9 +79,12 @@ void make_oblique(Volume& v) {
         for (int j = 0; j < 3; ++j) {
             r[i][j] = (i == j ? c : 0) + (1 - c) * ax[i] * ax[j];
         }
-    r[0][1] -= s * ax[2]; r[0][2] += s * ax[1];
-    r[1][0] += s * ax[2]; r[1][2] -= s * ax[0];
-    r[2][0] -= s * ax[1]; r[2][1] += s * ax[0];
+    r[0][1] -= s * ax[2];
+    r[0][2] += s * ax[1];
+    r[1][0] += s * ax[2];
+    r[1][2] -= s * ax[0];
+    r[2][0] -= s * ax[1];
+    r[2][1] += s * ax[0];
     set_ras_direction(v, r);
     v.spacing = {0.9, 1.3, 1.1};
     set_ras_origin(v, {-17.5, 4.25, -9});
@@ -130,7 +134,8 @@ TEST(Mpr, TrilinearMatchesDoublePrecisionOnAnObliqueVolume) {
             // x 2000 x 9.5e-7 = 5.7e-3. The 7 lerps on values <= 1500 round by <= 2 x 2^-14 ~
             // 1.2e-4 each: < 1e-3 in all. Bound 6.7e-3; 0.01 leaves a margin, a wrong corner or
             // weight is off by tens.
-            expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.01, to_string(pl));
+            expect_slice(
+                v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.01, to_string(pl));
         }
 }
 
@@ -150,8 +155,9 @@ TEST(Mpr, LinearRampComesOutLinearStraightAndOblique) {
             // Trilinear reproduces a linear function exactly, up to float: the index rounds by
             // <= 9.5e-7 voxels per axis (indices < 32), moving the ramp by <= (2 + 3 + 5) x
             // 9.5e-7 ~ 1e-5, and 7 lerps on values <= 256 round by <= 7 x 2^-16 ~ 1.1e-4.
-            expect_slice(v, s, [](Vec3d p) { return 2 * p.x - 3 * p.y + 5 * p.z + 7; }, 1e-3,
-                         std::string(oblique ? "oblique " : "straight ") + to_string(pl));
+            expect_slice(
+                v, s, [](Vec3d p) { return 2 * p.x - 3 * p.y + 5 * p.z + 7; }, 1e-3,
+                std::string(oblique ? "oblique " : "straight ") + to_string(pl));
         }
     }
 }
@@ -232,8 +238,8 @@ TEST(Mpr, PhantomInThreeVoxelOrdersGivesTheSameSlices) {
                         // differ by <= 2 x 9.6e-4 ~ 1.9e-3 (so 1e-3 was too tight). 5e-3; a
                         // wrong voxel order is off by whole grey steps. Nearest: the same voxel.
                         ASSERT_NEAR(x, y, in == Interpolation::Nearest ? 0.0 : 5e-3)
-                            << to_string(pl) << " " << to_string(in) << " " << orientation_code(*other)
-                            << " pixel " << p;
+                            << to_string(pl) << " " << to_string(in) << " "
+                            << orientation_code(*other) << " pixel " << p;
                     }
                     EXPECT_GT(shown, a.values.size() / 2);
                     size_t nan_a = 0, nan_b = 0;
@@ -256,7 +262,8 @@ TEST(Mpr, OutsideTheVolumeIsNaNAndShownBlack) {
     // The oblique box's corners on a central plane are outside.
     const Slice s = sample_slice(v, SlicePlane::Coronal, c);
     // 0.01: the bound of TrilinearMatchesDoublePrecisionOnAnObliqueVolume (same values).
-    expect_slice(v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.01, "coronal");
+    expect_slice(
+        v, s, [&](Vec3d p) { return trilinear_d(v, p); }, 0.01, "coronal");
     const Image img = window_level(s, 400, 500);
     size_t nan = 0;
     for (size_t p = 0; p < s.values.size(); ++p)
@@ -345,7 +352,8 @@ TEST(Mpr, ProbeMatchesBruteForce) {
     labels.origin = v.origin;
     std::copy(std::begin(v.direction), std::end(v.direction), std::begin(labels.direction));
     LabelTable table = default_label_table(labels);
-    for (int l = 0; l < table.size(); ++l) table.styles[size_t(l)].name = "label" + std::to_string(l);
+    for (int l = 0; l < table.size(); ++l)
+        table.styles[size_t(l)].name = "label" + std::to_string(l);
     Rng rng{99};
     const Box3f b = world_bounds(v);
     size_t in = 0, out = 0;
@@ -388,14 +396,20 @@ TEST(Mpr, BadInputIsAOneLineErrorNamingTheField) {
         }
         return std::string("no error");
     };
-    EXPECT_NE(message([&] { slice_geometry(v, SlicePlane::Axial, {NAN, 0, 0}); }).find("point"),
+    EXPECT_NE(message([&] {
+                  slice_geometry(v, SlicePlane::Axial, {NAN, 0, 0});
+              }).find("point"),
               std::string::npos);
     SliceOptions o;
     o.pixel_mm = -1;
-    EXPECT_NE(message([&] { slice_geometry(v, SlicePlane::Axial, {0, 0, 0}, o); }).find("pixel_mm"),
+    EXPECT_NE(message([&] {
+                  slice_geometry(v, SlicePlane::Axial, {0, 0, 0}, o);
+              }).find("pixel_mm"),
               std::string::npos);
     o.pixel_mm = 1e-6;
-    EXPECT_NE(message([&] { slice_geometry(v, SlicePlane::Axial, {0, 0, 0}, o); }).find("pixel_mm"),
+    EXPECT_NE(message([&] {
+                  slice_geometry(v, SlicePlane::Axial, {0, 0, 0}, o);
+              }).find("pixel_mm"),
               std::string::npos);
     EXPECT_NE(message([&] { parse_slice_plane("oblique"); }).find("plane"), std::string::npos);
     // max_size coarsens the pixel, keeping the extent.

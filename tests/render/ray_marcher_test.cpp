@@ -93,7 +93,8 @@ TEST(RayMarcher, SphereSilhouetteIsWhereGeometryPutsIt) {
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
-                const float d = std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c));
+                const float d =
+                    std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c));
                 v.set_value(i, j, k, d <= radius ? 255 : 0);
             }
     v.compute_range();

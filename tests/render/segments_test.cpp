@@ -2,6 +2,8 @@
 // the octree against the same renderer without it (byte for byte), mask mode with every label
 // visible against the plain ray marcher, hiding a label against erasing it from the label map,
 // label tables (JSON, MRIcron .lut) and their errors.
+#include "lacuna/segments.h"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -14,14 +16,13 @@
 #include "lacuna/error.h"
 #include "lacuna/io.h"
 #include "lacuna/renderer.h"
-#include "lacuna/segments.h"
 #include "lacuna/synthetic.h"
 
 namespace lacuna {
 namespace {
 
-using test::Rng;
 using test::random_camera;
+using test::Rng;
 namespace fs = std::filesystem;
 
 // Label blobs: a few random boxes of random labels over background 0 (runs and boundaries like
@@ -94,8 +95,8 @@ TEST(LabelOctree, NodeLabelSetsEqualBruteForceOverTheirVoxels) {
     for (int trial = 0; trial < 6; ++trial) {
         const Vec3i d{rng.range(3, 37), rng.range(3, 37), rng.range(3, 37)};
         const int max_label = trial % 2 ? rng.range(1, 60) : rng.range(130, 400);  // 1..7 words
-        const Volume lab = random_labels(d, trial < 3 ? VoxelType::UInt16 : VoxelType::Int16,
-                                         max_label, rng);
+        const Volume lab =
+            random_labels(d, trial < 3 ? VoxelType::UInt16 : VoxelType::Int16, max_label, rng);
         SegmentOptions so;
         so.leaf_cells = 1 << rng.range(1, 4);
         const LabelOctree oct(lab, nullptr, so);
@@ -117,8 +118,8 @@ TEST(LabelOctree, NodeLabelSetsEqualBruteForceOverTheirVoxels) {
                         const uint64_t* got = oct.node_bits(p.index(l, x, y, z));
                         for (int w = 0; w < oct.words(); ++w)
                             ASSERT_EQ(got[w], want[size_t(w)])
-                                << "trial " << trial << " level " << l << " node " << x << ","
-                                << y << "," << z << " word " << w;
+                                << "trial " << trial << " level " << l << " node " << x << "," << y
+                                << "," << z << " word " << w;
                     }
     }
 }
@@ -128,8 +129,8 @@ TEST(Segments, OctreeSkippingIsByteIdenticalToMarchingEverySample) {
     for (int trial = 0; trial < 24; ++trial) {
         const Vec3i d{rng.range(5, 33), rng.range(5, 33), rng.range(5, 33)};
         const int max_label = rng.coin(3) ? rng.range(130, 300) : rng.range(1, 116);
-        const Volume lab = random_labels(
-            d, max_label > 255 ? VoxelType::UInt16 : VoxelType::UInt8, max_label, rng);
+        const Volume lab = random_labels(d, max_label > 255 ? VoxelType::UInt16 : VoxelType::UInt8,
+                                         max_label, rng);
         const Volume inten = random_intensity(d, rng);
         SegmentOptions so;
         so.mode = rng.coin() ? SegmentMode::Masked : SegmentMode::Labels;
@@ -152,8 +153,9 @@ TEST(Segments, OctreeSkippingIsByteIdenticalToMarchingEverySample) {
             ref.set_labels(t);
             fast.set_labels(t);
             const RenderResult a = ref.render(cam, ro), b = fast.render(cam, ro);
-            expect_same(a, b, "trial " + std::to_string(trial) + " edit " + std::to_string(edit) +
-                                  " mode " + to_string(so.mode));
+            expect_same(a, b,
+                        "trial " + std::to_string(trial) + " edit " + std::to_string(edit) +
+                            " mode " + to_string(so.mode));
             ASSERT_LE(b.stats.samples, a.stats.samples);
         }
     }
@@ -189,8 +191,9 @@ TEST(Segments, MaskModeIsExactThroughEveryIntensityStructure) {
                 seg.set_accel(accel.get());
                 const RenderResult r = seg.render(cam, ro);
                 seg.set_accel(nullptr);
-                expect_same(r, ref, "trial " + std::to_string(trial) + " accel " + to_string(k) +
-                                        " " + to_string(interp));
+                expect_same(r, ref,
+                            "trial " + std::to_string(trial) + " accel " + to_string(k) + " " +
+                                to_string(interp));
                 ASSERT_LE(r.stats.samples, ref.stats.samples) << to_string(k);
             }
         }

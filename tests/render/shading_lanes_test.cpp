@@ -21,11 +21,14 @@ namespace {
 
 using test::Rng;
 
-bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 Vec3f random_unit(Rng& rng) {
     for (;;) {
-        const Vec3f v{2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f};
+        const Vec3f v{2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f,
+                      2.f * rng.uniform() - 1.f};
         if (length(v) > 0.1f) return normalize(v);
     }
 }
@@ -33,11 +36,16 @@ Vec3f random_unit(Rng& rng) {
 // A random position in the box, sometimes on a face, on a cell boundary or slightly outside.
 float coordinate(Rng& rng, float hi) {
     switch (rng.range(0, 5)) {
-        case 0: return 0.f;
-        case 1: return hi;
-        case 2: return float(rng.range(0, int(hi)));
-        case 3: return -0.5f + (hi + 1.f) * rng.uniform();
-        default: return hi * rng.uniform();
+        case 0:
+            return 0.f;
+        case 1:
+            return hi;
+        case 2:
+            return float(rng.range(0, int(hi)));
+        case 3:
+            return -0.5f + (hi + 1.f) * rng.uniform();
+        default:
+            return hi * rng.uniform();
     }
 }
 
@@ -65,10 +73,11 @@ void check_samples_and_gradients(const Volume& v, const T* data, Rng& rng, simd:
     const float* grad[3] = {gvol[0].data(), gvol[1].data(), gvol[2].data()};
     for (int trial = 0; trial < 200; ++trial) {
         // Lattice samples of a random ray; positions anywhere in (or just outside) the box.
-        const simd::ShadeRay r{{coordinate(rng, g.hi_x), coordinate(rng, g.hi_y), coordinate(rng, g.hi_z)},
-                               {2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f},
-                               -2.f + 4.f * rng.uniform(),
-                               0.05f + rng.uniform()};
+        const simd::ShadeRay r{
+            {coordinate(rng, g.hi_x), coordinate(rng, g.hi_y), coordinate(rng, g.hi_z)},
+            {2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f},
+            -2.f + 4.f * rng.uniform(),
+            0.05f + rng.uniform()};
         alignas(32) int32_t k[8];
         for (int l = 0; l < 8; ++l) k[l] = rng.range(0, 40);
         alignas(32) float x[8], y[8], z[8], val[8], gx[8], gy[8], gz[8], hx[8], hy[8], hz[8];
@@ -77,7 +86,8 @@ void check_samples_and_gradients(const Volume& v, const T* data, Rng& rng, simd:
 #if LACUNA_SIMD_X86
         if (isa == simd::Isa::Sse41) {
             mask = unsigned(simd::samples4(sg, r, data, k, x, y, z, val, e)) |
-                   unsigned(simd::samples4(sg, r, data, k + 4, x + 4, y + 4, z + 4, val + 4, e + 4)) << 4;
+                   unsigned(simd::samples4(sg, r, data, k + 4, x + 4, y + 4, z + 4, val + 4, e + 4))
+                       << 4;
             simd::gradients4(sg, data, x, y, z, gx, gy, gz);
             simd::gradients4(sg, data, x + 4, y + 4, z + 4, gx + 4, gy + 4, gz + 4);
             simd::volume_gradients4(sg, grad, x, y, z, hx, hy, hz);
@@ -90,10 +100,13 @@ void check_samples_and_gradients(const Volume& v, const T* data, Rng& rng, simd:
 #endif
         for (int l = 0; l < 8; ++l) {
             const float t = r.t_base + (float(k[l]) + 0.5f) * r.dt;
-            const float px = r.o[0] + t * r.d[0], py = r.o[1] + t * r.d[1], pz = r.o[2] + t * r.d[2];
-            ASSERT_TRUE(same_bits(px, x[l]) && same_bits(py, y[l]) && same_bits(pz, z[l])) << "lane " << l;
+            const float px = r.o[0] + t * r.d[0], py = r.o[1] + t * r.d[1],
+                        pz = r.o[2] + t * r.d[2];
+            ASSERT_TRUE(same_bits(px, x[l]) && same_bits(py, y[l]) && same_bits(pz, z[l]))
+                << "lane " << l;
             const float ref = kernel::trilinear(g, px, py, pz);
-            ASSERT_TRUE(same_bits(ref, val[l])) << ref << " vs " << val[l] << " at " << px << "," << py << "," << pz;
+            ASSERT_TRUE(same_bits(ref, val[l]))
+                << ref << " vs " << val[l] << " at " << px << "," << py << "," << pz;
             ASSERT_EQ(c.map(ref), e[l]);
             ASSERT_EQ(lut.entries[size_t(e[l])].a > 0.f, bool(mask >> l & 1u));
             c.grad[0] = nullptr;
@@ -121,7 +134,8 @@ TEST(ShadingLanes, SamplesAndGradientsEqualTheScalarOnes) {
         for (int vol = 0; vol < 12; ++vol) {
             Volume v = test::random_volume(rng, 14);
             v.spacing = {0.5 + rng.uniform(), 0.5 + rng.uniform(), 0.5 + 2.0 * rng.uniform()};
-            visit_voxels(v, [&](const auto* data) { check_samples_and_gradients(v, data, rng, isa); });
+            visit_voxels(v,
+                         [&](const auto* data) { check_samples_and_gradients(v, data, rng, isa); });
             if (HasFailure()) return;
         }
     }
@@ -139,8 +153,10 @@ TEST(ShadingLanes, PhongAndPbrEqualTheScalarOnes) {
         const float li = trial % 5 == 0 ? 0.f : 2.f * rng.uniform();
         Vec3f h{0, 0, 1};
         const bool h_ok = shading::half_vector(l, view, h);
-        const simd::ShadeLight L{{l.x, l.y, l.z}, {view.x, view.y, view.z}, {h.x, h.y, h.z}, h_ok, li};
-        const PhongParams pp{rng.uniform(), rng.uniform(), rng.uniform(), trial % 13 == 0 ? 0.f : 64.f * rng.uniform()};
+        const simd::ShadeLight L{
+            {l.x, l.y, l.z}, {view.x, view.y, view.z}, {h.x, h.y, h.z}, h_ok, li};
+        const PhongParams pp{rng.uniform(), rng.uniform(), rng.uniform(),
+                             trial % 13 == 0 ? 0.f : 64.f * rng.uniform()};
         const PbrParams pb{0.01f + rng.uniform(), rng.uniform(), rng.uniform()};
         alignas(32) float gx[8], gy[8], gz[8], r[8], g[8], b[8], r2[8], g2[8], b2[8];
         Rgba in[8];
@@ -160,13 +176,16 @@ TEST(ShadingLanes, PhongAndPbrEqualTheScalarOnes) {
                 rgb = shading::phong_h(pp, rgb, nrm, l, h, h_ok, li);
                 rgb2 = shading::pbr_h(pb, rgb2, nrm, l, view, h, li);
                 // phong_h and pbr_h are what phong() and pbr() compute.
-                const Vec3f p = shading::phong(pp, Vec3f{in[j].r, in[j].g, in[j].b}, nrm, l, view, li);
-                ASSERT_TRUE(same_bits(p.x, rgb.x) && same_bits(p.y, rgb.y) && same_bits(p.z, rgb.z));
+                const Vec3f p =
+                    shading::phong(pp, Vec3f{in[j].r, in[j].g, in[j].b}, nrm, l, view, li);
+                ASSERT_TRUE(same_bits(p.x, rgb.x) && same_bits(p.y, rgb.y) &&
+                            same_bits(p.z, rgb.z));
             }
             ASSERT_TRUE(same_bits(rgb.x, r[j]) && same_bits(rgb.y, g[j]) && same_bits(rgb.z, b[j]))
                 << "phong trial " << trial << " lane " << j << ": " << rgb.x << " vs " << r[j];
             if (h_ok)
-                ASSERT_TRUE(same_bits(rgb2.x, r2[j]) && same_bits(rgb2.y, g2[j]) && same_bits(rgb2.z, b2[j]))
+                ASSERT_TRUE(same_bits(rgb2.x, r2[j]) && same_bits(rgb2.y, g2[j]) &&
+                            same_bits(rgb2.z, b2[j]))
                     << "pbr trial " << trial << " lane " << j << ": " << rgb2.x << " vs " << r2[j];
         }
     }

@@ -2,19 +2,20 @@
 // ball against its analytic normal, the PBR terms at normal incidence, shadow transmittance in a
 // uniform medium, MIP against known volumes and brute force, clip planes and the crop box
 // removing exactly their half-spaces, jitter determinism, and the light volume cache.
+#include "render/shading.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "accel/no_accel.h"
-#include "core/gradient.h"
-#include "core/spec_pow.h"
 #include "common/rng.h"
 #include "conformance/conformance_util.h"
+#include "core/gradient.h"
+#include "core/spec_pow.h"
 #include "lacuna/error.h"
 #include "lacuna/renderer.h"
 #include "render/feature_kernel.h"
-#include "render/shading.h"
 
 namespace lacuna {
 namespace {
@@ -27,7 +28,8 @@ Volume ball(int n, float radius, Vec3d spacing = {1, 1, 1}) {
     for (int z = 0; z < n; ++z)
         for (int y = 0; y < n; ++y)
             for (int x = 0; x < n; ++x) {
-                const float r = std::sqrt((x - c) * (x - c) + (y - c) * (y - c) + (z - c) * (z - c));
+                const float r =
+                    std::sqrt((x - c) * (x - c) + (y - c) * (y - c) + (z - c) * (z - c));
                 v.set_value(x, y, z, 1000.f / (1.f + std::exp((r - radius) / 1.5f)));
             }
     v.compute_range();
@@ -60,8 +62,15 @@ TEST(Shading, OnTheFlyAndPrecomputedGradientsFollowTheBallsNormal) {
     FeatureOptions f;
     feature::Context c = context_for(v, f);
     const Vec3i d = v.dims();
-    const kernel::Grid<float, int64_t> g{v.data_as<float>(), d.x, ptrdiff_t(d.x) * d.y, float(d.x - 1),
-                                         float(d.y - 1), float(d.z - 1), d.x - 2, d.y - 2, d.z - 2};
+    const kernel::Grid<float, int64_t> g{v.data_as<float>(),
+                                         d.x,
+                                         ptrdiff_t(d.x) * d.y,
+                                         float(d.x - 1),
+                                         float(d.y - 1),
+                                         float(d.z - 1),
+                                         d.x - 2,
+                                         d.y - 2,
+                                         d.z - 2};
     test::Rng rng{3};
     for (int i = 0; i < 200; ++i) {
         // Random points on the r = 10 sphere.
@@ -72,7 +81,8 @@ TEST(Shading, OnTheFlyAndPrecomputedGradientsFollowTheBallsNormal) {
         const Vec3f grad = feature::gradient(c, g, p.x, p.y, p.z);
         Vec3f n;
         ASSERT_TRUE(shading::normal_from_gradient(grad, u, n));
-        const Vec3f expected = normalize(Vec3f{u.x / float(sp.x), u.y / float(sp.y), u.z / float(sp.z)});
+        const Vec3f expected =
+            normalize(Vec3f{u.x / float(sp.x), u.y / float(sp.y), u.z / float(sp.z)});
         EXPECT_GT(dot(n, expected), std::cos(3.f * shading::kPi / 180.f)) << "point " << i;
     }
 }
@@ -93,16 +103,19 @@ TEST(Shading, OnTheFlyGradientIsTheCentralDifferenceOfTheTrilinearField) {
     const float hi[3] = {8, 6, 7}, inv_sp[3] = {1.f, 0.5f, 2.f};
     const int cell[3] = {7, 5, 6};
     auto vox = [&](int x, int y, int z) {
-        x = std::clamp(x, 0, dims[0] - 1), y = std::clamp(y, 0, dims[1] - 1), z = std::clamp(z, 0, dims[2] - 1);
+        x = std::clamp(x, 0, dims[0] - 1), y = std::clamp(y, 0, dims[1] - 1),
+        z = std::clamp(z, 0, dims[2] - 1);
         return double(d[z * sz + y * sy + x]);
     };
     auto field = [&](double x, double y, double z) {  // trilinear, double precision
-        const int i = std::min(int(x), cell[0]), j = std::min(int(y), cell[1]), k = std::min(int(z), cell[2]);
+        const int i = std::min(int(x), cell[0]), j = std::min(int(y), cell[1]),
+                  k = std::min(int(z), cell[2]);
         const double fx = x - i, fy = y - j, fz = z - k;
         double s = 0;
         for (int q = 0; q < 8; ++q) {
             const int a = q & 1, b = q >> 1 & 1, c = q >> 2;
-            s += (a ? fx : 1 - fx) * (b ? fy : 1 - fy) * (c ? fz : 1 - fz) * vox(i + a, j + b, k + c);
+            s += (a ? fx : 1 - fx) * (b ? fy : 1 - fy) * (c ? fz : 1 - fz) *
+                 vox(i + a, j + b, k + c);
         }
         return s;
     };
@@ -118,8 +131,10 @@ TEST(Shading, OnTheFlyGradientIsTheCentralDifferenceOfTheTrilinearField) {
             double lo[3] = {q[0], q[1], q[2]}, up[3] = {q[0], q[1], q[2]};
             if (inside) {
                 lo[a] -= 1, up[a] += 1;
-                const double want = (field(up[0], up[1], up[2]) - field(lo[0], lo[1], lo[2])) * 0.5 * inv_sp[a];
-                ASSERT_NEAR(g[a], want, 2e-3 * (1 + std::abs(want))) << "axis " << a << " trial " << trial;
+                const double want =
+                    (field(up[0], up[1], up[2]) - field(lo[0], lo[1], lo[2])) * 0.5 * inv_sp[a];
+                ASSERT_NEAR(g[a], want, 2e-3 * (1 + std::abs(want)))
+                    << "axis " << a << " trial " << trial;
             } else {
                 // The border voxel repeated: interpolate v[i+1] - v[i-1] with clamped indices.
                 const int i = std::min(int(q[0]), cell[0]), j = std::min(int(q[1]), cell[1]),
@@ -134,7 +149,8 @@ TEST(Shading, OnTheFlyGradientIsTheCentralDifferenceOfTheTrilinearField) {
                     ++u[a], --m[a];
                     s += w * (vox(u[0], u[1], u[2]) - vox(m[0], m[1], m[2]));
                 }
-                ASSERT_NEAR(g[a], s * 0.5 * inv_sp[a], 2e-3 * (1 + std::abs(s))) << "face, axis " << a;
+                ASSERT_NEAR(g[a], s * 0.5 * inv_sp[a], 2e-3 * (1 + std::abs(s)))
+                    << "face, axis " << a;
             }
         }
         interior += inside;
@@ -153,7 +169,8 @@ TEST(Shading, LambertTermOfAShadedBallMatchesTheAnalyticNormal) {
         RayMarcher m(v);
         m.set_transfer_function(step_lut(v, 500.f));
         OrbitParams p;
-        p.azimuth_deg = 0, p.elevation_deg = 90, p.projection = Projection::Orthographic;  // eye on +z, x right, y up
+        p.azimuth_deg = 0, p.elevation_deg = 90,
+        p.projection = Projection::Orthographic;  // eye on +z, x right, y up
         const int size = 64;
         const Camera cam = Camera::orbit(m.bounds(), p, size, size);
         RenderOptions ro;
@@ -229,7 +246,8 @@ TEST(Shading, SpecularPowerIsThePowerWithinUlps) {
     }
     EXPECT_GT(worst, 0.0) << "binary exponentiation rounds somewhere";
     for (float p : {0.5f, 2.5f, 300.f, 0.f})
-        for (float x : {0.f, 0.25f, 0.9f, 1.f}) EXPECT_EQ(simd::spec_pow(x, p), std::pow(x, p)) << x << "^" << p;
+        for (float x : {0.f, 0.25f, 0.9f, 1.f})
+            EXPECT_EQ(simd::spec_pow(x, p), std::pow(x, p)) << x << "^" << p;
     EXPECT_EQ(simd::spec_pow(0.5f, 24.f), std::ldexp(1.f, -24));  // exact powers of two stay exact
 }
 
@@ -282,7 +300,8 @@ TEST(Shading, ShadowsDarkenWhatIsBehindAnOccluder) {
     RayMarcher m(v);
     m.set_transfer_function(step_lut(v, 90.f, {1, 1, 1, 0.5f}));
     OrbitParams p;
-    p.azimuth_deg = 0, p.elevation_deg = 90, p.projection = Projection::Orthographic;  // eye on +z, x right, y up
+    p.azimuth_deg = 0, p.elevation_deg = 90,
+    p.projection = Projection::Orthographic;  // eye on +z, x right, y up
     const Camera cam = Camera::orbit(m.bounds(), p, 48, 48);
     RenderOptions ro;
     ro.features.light.kind = LightKind::Directional;
@@ -316,11 +335,13 @@ TEST(Shading, MipOfARampIsTheRampValueOfEachColumn) {
     TransferLut lut;
     lut.vis = v.vis_range();
     lut.entries.resize(kDefaultLutSize);
-    for (int e = 0; e < kDefaultLutSize; ++e) lut.entries[size_t(e)] = {float(e) / 1023.f, 0, 0, 1.f};
+    for (int e = 0; e < kDefaultLutSize; ++e)
+        lut.entries[size_t(e)] = {float(e) / 1023.f, 0, 0, 1.f};
     RayMarcher m(v);
     m.set_transfer_function(lut);
     OrbitParams p;
-    p.azimuth_deg = 0, p.elevation_deg = 90, p.projection = Projection::Orthographic;  // eye on +z, x right, y up
+    p.azimuth_deg = 0, p.elevation_deg = 90,
+    p.projection = Projection::Orthographic;  // eye on +z, x right, y up
     const Camera cam = Camera::orbit(m.bounds(), p, 50, 50);
     RenderOptions ro;
     ro.features.blend = BlendMode::Mip;
@@ -347,7 +368,8 @@ TEST(Shading, MipEqualsTheBruteForceMaximumAlongEachRay) {
         lut.vis = v.vis_range();
         lut.entries.resize(kDefaultLutSize);
         for (int e = 0; e < kDefaultLutSize; ++e)
-            lut.entries[size_t(e)] = {float(e) / 1023.f, 1.f - float(e) / 1023.f, 0.5f, 0.2f + 0.8f * float(e) / 1023.f};
+            lut.entries[size_t(e)] = {float(e) / 1023.f, 1.f - float(e) / 1023.f, 0.5f,
+                                      0.2f + 0.8f * float(e) / 1023.f};
         RayMarcher m(v);
         m.set_transfer_function(lut);
         const Camera cam = test::random_camera(v, rng, 24);
@@ -363,7 +385,8 @@ TEST(Shading, MipEqualsTheBruteForceMaximumAlongEachRay) {
         for (int y = 0; y < 24; ++y)
             for (int x = 0; x < 24; ++x) {
                 const Ray ray = cam.generate(float(x), float(y));
-                const kernel::IndexRay ir{ray.origin.x, ray.origin.y, ray.origin.z, ray.dir.x, ray.dir.y, ray.dir.z};
+                const kernel::IndexRay ir{ray.origin.x, ray.origin.y, ray.origin.z,
+                                          ray.dir.x,    ray.dir.y,    ray.dir.z};
                 const float hi[3] = {float(d.x - 1), float(d.y - 1), float(d.z - 1)};
                 float t0, t1;
                 float expected = 0.f;
@@ -381,8 +404,8 @@ TEST(Shading, MipEqualsTheBruteForceMaximumAlongEachRay) {
                         float val = 0;
                         for (int c = 0; c < 8; ++c) {
                             const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
-                            val += v.value(i + dx, j + dy, kk + dz) * (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) *
-                                   (dz ? fz : 1 - fz);
+                            val += v.value(i + dx, j + dy, kk + dz) * (dx ? fx : 1 - fx) *
+                                   (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
                         }
                         best = std::max(best, lut.map()(val));
                     }
@@ -390,7 +413,8 @@ TEST(Shading, MipEqualsTheBruteForceMaximumAlongEachRay) {
                 }
                 // The alpha of the max entry; float trilinear order may move a value across an
                 // entry boundary, so allow one entry's worth.
-                EXPECT_NEAR(r.rgba_float[(size_t(y) * 24 + x) * 4 + 3], expected, 0.8f / 1023.f + 1e-6f)
+                EXPECT_NEAR(r.rgba_float[(size_t(y) * 24 + x) * 4 + 3], expected,
+                            0.8f / 1023.f + 1e-6f)
                     << "trial " << trial << " pixel " << x << "," << y;
             }
     }
@@ -409,7 +433,8 @@ TEST(Shading, ClipPlanesRemoveExactlyTheirHalfSpace) {
     TransferLut lut = step_lut(v, 200.f, {0.8f, 0.7f, 0.6f, 0.3f});
     m.set_transfer_function(lut);
     OrbitParams p;
-    p.azimuth_deg = 0, p.elevation_deg = 90, p.projection = Projection::Orthographic;  // eye on +z, x right, y up
+    p.azimuth_deg = 0, p.elevation_deg = 90,
+    p.projection = Projection::Orthographic;  // eye on +z, x right, y up
     const Camera cam = Camera::orbit(m.bounds(), p, 60, 60);
     RenderOptions ro;
     ro.background = {0, 0, 1};
@@ -447,8 +472,8 @@ TEST(Shading, ClipPlanesRemoveExactlyTheirHalfSpace) {
     const uint64_t s2 = m.render(cam, ro).stats.samples;
     ro.features.clip_planes.clear();
     const uint64_t s_all = render_unclipped(m, cam, ro).stats.samples;
-    EXPECT_GE(s1 + s2, s_all);          // samples exactly on the plane are kept by both
-    EXPECT_LE(s1 + s2, s_all + 60 * 60); // ... at most one per ray in practice
+    EXPECT_GE(s1 + s2, s_all);            // samples exactly on the plane are kept by both
+    EXPECT_LE(s1 + s2, s_all + 60 * 60);  // ... at most one per ray in practice
     (void)other;
 }
 
@@ -457,7 +482,8 @@ TEST(Shading, CropBoxKeepsExactlyItsInside) {
     RayMarcher m(v);
     m.set_transfer_function(step_lut(v, 200.f, {0.8f, 0.7f, 0.6f, 0.3f}));
     OrbitParams p;
-    p.azimuth_deg = 0, p.elevation_deg = 90, p.projection = Projection::Orthographic;  // eye on +z, x right, y up
+    p.azimuth_deg = 0, p.elevation_deg = 90,
+    p.projection = Projection::Orthographic;  // eye on +z, x right, y up
     const Camera cam = Camera::orbit(m.bounds(), p, 60, 60);
     RenderOptions ro;
     ro.background = {0, 0, 1};
@@ -470,8 +496,8 @@ TEST(Shading, CropBoxKeepsExactlyItsInside) {
             const Ray ray = cam.generate(float(x), float(y));
             const bool in = ray.origin.x >= 5.f && ray.origin.x <= 20.f && ray.origin.y >= 8.f &&
                             ray.origin.y <= 26.f;
-            const bool out = ray.origin.x < 4.99f || ray.origin.x > 20.01f || ray.origin.y < 7.99f ||
-                             ray.origin.y > 26.01f;
+            const bool out = ray.origin.x < 4.99f || ray.origin.x > 20.01f ||
+                             ray.origin.y < 7.99f || ray.origin.y > 26.01f;
             const uint8_t* a = crop.image.pixel(x, y);
             if (in) EXPECT_TRUE(std::equal(a, a + 4, full.image.pixel(x, y))) << x << "," << y;
             if (out) EXPECT_EQ(a[2], 255) << x << "," << y;
@@ -530,7 +556,8 @@ TEST(Shading, GradientOpacityRemovesHomogeneousRegionsOnly) {
     RayMarcher m(v);
     m.set_transfer_function(step_lut(v, 150.f, {1, 1, 1, 0.05f}));
     OrbitParams p;
-    p.azimuth_deg = 0, p.elevation_deg = 90, p.projection = Projection::Orthographic;  // eye on +z, x right, y up
+    p.azimuth_deg = 0, p.elevation_deg = 90,
+    p.projection = Projection::Orthographic;  // eye on +z, x right, y up
     const Camera cam = Camera::orbit(m.bounds(), p, 32, 32);
     RenderOptions ro;
     ro.keep_float = true;
@@ -577,7 +604,8 @@ TEST(Shading, GradientOpacityPointsMatchTheirDefinition) {
                                       : (x + 80.f) * rng.uniform();
             const float got = shading::gradient_opacity(g, m);
             // Float error: m - x and the width (< 64, widths >= 1) each within ulp(64)/2 = 4e-6.
-            EXPECT_NEAR(got, gradient_factor_reference(pts, m), 1e-5) << "trial " << trial << " m " << m;
+            EXPECT_NEAR(got, gradient_factor_reference(pts, m), 1e-5)
+                << "trial " << trial << " m " << m;
             // Exact where the definition is exact: at the points' values and on flat stretches.
             size_t i = 0;
             while (i + 1 < pts.size() && pts[i + 1].x <= m) ++i;
@@ -593,7 +621,8 @@ TEST(Shading, GradientOpacityRampIsItsTwoPointFunctionBitForBit) {
     // the ramp formula (m - lo) / (hi - lo), so images made with the ramp did not change.
     test::Rng rng(7);
     for (int trial = 0; trial < 100; ++trial) {
-        const float lo = 50.f * rng.uniform(), hi = trial % 10 == 0 ? lo : lo + 80.f * rng.uniform();
+        const float lo = 50.f * rng.uniform(),
+                    hi = trial % 10 == 0 ? lo : lo + 80.f * rng.uniform();
         GradientOpacity ramp;
         ramp.enabled = true;
         ramp.lo = lo, ramp.hi = hi;
@@ -676,8 +705,12 @@ TEST(Shading, InvalidOptionsThrow) {
     };
     bad([](FeatureOptions& f) { f.clip_planes = {{{0, 0, 0}, 1.f}}; });
     bad([](FeatureOptions& f) { f.crop = true, f.crop_box = {{2, 0, 0}, {1, 1, 1}}; });
-    bad([](FeatureOptions& f) { f.light.kind = LightKind::Spot, f.light.position = f.light.target = {1, 1, 1}; });
-    bad([](FeatureOptions& f) { f.light.kind = LightKind::Directional, f.light.direction = {0, 0, 0}; });
+    bad([](FeatureOptions& f) {
+        f.light.kind = LightKind::Spot, f.light.position = f.light.target = {1, 1, 1};
+    });
+    bad([](FeatureOptions& f) {
+        f.light.kind = LightKind::Directional, f.light.direction = {0, 0, 0};
+    });
     bad([](FeatureOptions& f) { f.pbr.roughness = 0.f, f.shading = ShadingModel::Pbr; });
     bad([](FeatureOptions& f) { f.gradient_opacity = {true, 2.f, 1.f}; });
     auto points = [](std::vector<GradientOpacityPoint> p) {
@@ -686,11 +719,11 @@ TEST(Shading, InvalidOptionsThrow) {
             f.gradient_opacity.points = p;
         };
     };
-    bad(points({{5.f, 0.f}, {1.f, 1.f}}));                // unsorted
-    bad(points({{1.f, 0.f}, {1.f, 0.5f}, {1.f, 1.f}}));   // three at one x
-    bad(points({{0.f, 0.f}, {1.f, 1.5f}}));               // a > 1
-    bad(points({{-1.f, 0.f}, {1.f, 1.f}}));               // x < 0
-    bad(points({{0.f, 0.f}, {INFINITY, 1.f}}));           // x not finite
+    bad(points({{5.f, 0.f}, {1.f, 1.f}}));               // unsorted
+    bad(points({{1.f, 0.f}, {1.f, 0.5f}, {1.f, 1.f}}));  // three at one x
+    bad(points({{0.f, 0.f}, {1.f, 1.5f}}));              // a > 1
+    bad(points({{-1.f, 0.f}, {1.f, 1.f}}));              // x < 0
+    bad(points({{0.f, 0.f}, {INFINITY, 1.f}}));          // x not finite
     bad([](FeatureOptions& f) { f.shadows.step = 0.f; });
     // A back TF needs a plane, and the same LUT layout.
     TransferLut back = step_lut(v, 100.f);

@@ -84,11 +84,11 @@ TEST(FrameRenderer, SameBytesAsTheCliRenderer) {
 TEST(FrameRenderer, SliceRendererFramesAreTheCliSlicer) {
     for (const char* accel : {"none", "kdtree"}) {
         const fs::path out = temp_dir() / (std::string("cli_slice_") + accel + ".png");
-        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " +
-                                shells_file().string() +
+        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + shells_file().string() +
                                 " --tf mr-default --renderer slice --accel " + accel +
                                 " --width 40 --height 36 --azimuth 40 --elevation 20 --zoom 1.3"
-                                " --step 0.5 --ert 1 --out " + out.string() + " >/dev/null";
+                                " --step 0.5 --ert 1 --out " +
+                                out.string() + " >/dev/null";
         const int status = std::system(cmd.c_str());
         ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
         const Image cli = read_png(out.string());
@@ -115,11 +115,12 @@ TEST(FrameRenderer, SegmentFramesAreTheCliSegments) {
     EXPECT_GT(fr.label_count(), 1);
     for (const char* accel : {"bitfield", "minmax", "none"}) {
         const fs::path out = temp_dir() / (std::string("cli_seg_") + accel + ".png");
-        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " +
-                                shells_file().string() + " --labels " + labels.string() +
+        const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + shells_file().string() +
+                                " --labels " + labels.string() +
                                 " --hide 1-100 --tf mr-default --accel " + accel +
                                 " --width 40 --height 36 --azimuth 40 --elevation 20 --zoom 1.3"
-                                " --step 0.5 --ert 1 --out " + out.string() + " >/dev/null";
+                                " --step 0.5 --ert 1 --out " +
+                                out.string() + " >/dev/null";
         const int status = std::system(cmd.c_str());
         ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
         ViewRequest req = request(parse_accel(accel), "mr-default");
@@ -138,8 +139,8 @@ TEST(FrameRenderer, ShadingAndClipTogglesAreTheCliFlags) {
     const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + shells_file().string() +
                             " --tf mr-default --accel minmax --width 40 --height 36"
                             " --azimuth 40 --elevation 20 --zoom 1.3 --step 0.5 --ert 1"
-                            " --shading phong --clip -1,0,0,-16 --out " + out.string() +
-                            " >/dev/null";
+                            " --shading phong --clip -1,0,0,-16 --out " +
+                            out.string() + " >/dev/null";
     const int status = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
     const Image cli = read_png(out.string());
@@ -170,8 +171,8 @@ TEST(FrameRenderer, ClipPlaneAndViewsAreInPatientRasOnAnLpsVolume) {
     const std::string cmd = std::string(LACUNA_CLI_PATH) + " render " + file.string() +
                             " --tf mr-default --accel grid --width 40 --height 36"
                             " --view left --zoom 1.3 --step 0.5 --ert 1"
-                            " --shading phong --clip -1,0,0,26 --out " + out.string() +
-                            " >/dev/null";
+                            " --shading phong --clip -1,0,0,26 --out " +
+                            out.string() + " >/dev/null";
     const int status = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
     FrameRenderer fr(read_volume(file.string()));

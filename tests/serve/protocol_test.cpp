@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
 #include <algorithm>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "lacuna/error.h"
@@ -332,7 +332,8 @@ TEST(Protocol, HelloCapabilitiesAreWhatRequestsMayCombine) {
         EXPECT_EQ(accepted(j), has(c["features"], "shading")) << row;
         for (const char* key : {"clip", "clip_planes"}) {
             j = base;
-            j[key] = std::string(key) == "clip" ? json(true) : json::array({json::array({1, 0, 0, 0})});
+            j[key] =
+                std::string(key) == "clip" ? json(true) : json::array({json::array({1, 0, 0, 0})});
             EXPECT_EQ(accepted(j), has(c["features"], "clip_planes")) << row << " " << key;
         }
     }

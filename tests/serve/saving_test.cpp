@@ -91,7 +91,8 @@ TransferFunction read_back(const std::string& vp_json) {
 TEST(SavingProtocol, ScreenshotAndSessionCarryTheRenderViewState) {
     for (const char* type : {"screenshot", "session"}) {
         const json j = view_json(type, 9);
-        const MessageKind kind = std::string(type) == "screenshot" ? MessageKind::Screenshot : MessageKind::Session;
+        const MessageKind kind =
+            std::string(type) == "screenshot" ? MessageKind::Screenshot : MessageKind::Session;
         EXPECT_EQ(message_kind(j.dump()), kind);
         const ViewRequest r = parse_view_request(j.dump(), kind);
         json as_render = j;
@@ -117,12 +118,17 @@ TEST(SavingProtocol, ErrorsNameTheField) {
         json value;  // null: remove the field
     };
     const Case cases[] = {
-        {"screenshot", "preview", true},   // a screenshot is never a preview
-        {"screenshot", "width", 0},        {"screenshot", "width", 5000},
-        {"screenshot", "height", nullptr}, {"screenshot", "tf", "mr-default"},
-        {"screenshot", "camera", nullptr}, {"screenshot", "accel", "octree"},
-        {"screenshot", "id", -3},          {"screenshot", "path", "/tmp/x.png"},
-        {"session", "step", 0},            {"session", "renderer", "raycast"},
+        {"screenshot", "preview", true},  // a screenshot is never a preview
+        {"screenshot", "width", 0},
+        {"screenshot", "width", 5000},
+        {"screenshot", "height", nullptr},
+        {"screenshot", "tf", "mr-default"},
+        {"screenshot", "camera", nullptr},
+        {"screenshot", "accel", "octree"},
+        {"screenshot", "id", -3},
+        {"screenshot", "path", "/tmp/x.png"},
+        {"session", "step", 0},
+        {"session", "renderer", "raycast"},
         {"session", "volume", "/etc/passwd"},
     };
     for (const Case& c : cases) {
@@ -145,10 +151,14 @@ TEST(SavingProtocol, ErrorsNameTheField) {
         {{{"type", "tf_export"}, {"id", 1}, {"format", "slicer"}, {"tf", {{"color", 1}}}}, "tf:"},
         {{{"type", "tf_import"}, {"id", 1}, {"name", "a.json"}}, "text: missing"},
         {{{"type", "tf_import"}, {"id", 1}, {"name", 3}, {"text", "{}"}}, "name:"},
-        {{{"type", "tf_import"}, {"id", 1}, {"name", std::string(300, 'a')}, {"text", "{}"}}, "name:"},
+        {{{"type", "tf_import"}, {"id", 1}, {"name", std::string(300, 'a')}, {"text", "{}"}},
+         "name:"},
         {{{"type", "tf_import"}, {"id", 1}, {"name", "a\nb"}, {"text", "{}"}}, "name:"},
         {{{"type", "tf_import"}, {"id", 1}, {"name", "a"}, {"text", "{}"}, {"path", "/"}}, "path:"},
-        {{{"type", "tf_import"}, {"id", 1}, {"name", "a.json"}, {"text", std::string(40, '[') + std::string(40, ']')}},
+        {{{"type", "tf_import"},
+          {"id", 1},
+          {"name", "a.json"},
+          {"text", std::string(40, '[') + std::string(40, ']')}},
          "nesting:"},
     };
     for (const auto& file : files) {  // (not a structured binding: clang's C++20 lambdas)
@@ -208,7 +218,8 @@ TEST(TfFiles, SlicerExportOfANormalizedTfIsItsValueDomainTf) {
         for (size_t i = 0; i < tf.opacity.size(); ++i) {
             double want = value_x(tf.opacity[i].x);
             if (i > 0 && tf.opacity[i].x == tf.opacity[i - 1].x)
-                want = std::nextafter(back.opacity[i - 1].x, std::numeric_limits<double>::infinity());
+                want =
+                    std::nextafter(back.opacity[i - 1].x, std::numeric_limits<double>::infinity());
             EXPECT_EQ(back.opacity[i].x, want) << name << " opacity " << i;
             EXPECT_EQ(back.opacity[i].a, tf.opacity[i].a) << name << " opacity " << i;
         }
@@ -281,7 +292,8 @@ TEST(TfFiles, UploadsAreReadByTheLibrarysReaders) {
     EXPECT_NE(e.find("expected one volume property"), std::string::npos) << e;
 }
 
-// ---- over a real WebSocket ------------------------------------------------------------------------
+// ---- over a real WebSocket
+// ------------------------------------------------------------------------
 
 namespace {
 
@@ -328,7 +340,8 @@ TEST(SavingServer, TheScreenshotIsTheCliRenderOfTheSavedSessionByteForByte) {
     json view = view_json("session", 21);
     view["width"] = 77;
     view["height"] = 51;
-    view["camera"] = {{"azimuth", 123.25}, {"elevation", -31.5}, {"zoom", 1.7}, {"pan", {0.05, -0.1}}};
+    view["camera"] = {
+        {"azimuth", 123.25}, {"elevation", -31.5}, {"zoom", 1.7}, {"pan", {0.05, -0.1}}};
     view["ert"] = false;
     view["step"] = 0.75;
     view["shading"] = true;
@@ -368,7 +381,8 @@ TEST(SavingServer, TheScreenshotIsTheCliRenderOfTheSavedSessionByteForByte) {
     const Image img = read_png(shot_png.string());
     EXPECT_EQ(img.width, 77);
     EXPECT_EQ(img.height, 51);
-    EXPECT_TRUE(std::any_of(img.rgba.begin(), img.rgba.end(), [](uint8_t b) { return b > 40 && b < 255; }));
+    EXPECT_TRUE(
+        std::any_of(img.rgba.begin(), img.rgba.end(), [](uint8_t b) { return b > 40 && b < 255; }));
 }
 
 TEST(SavingServer, AScreenshotIsNotDroppedForANewerRenderAndBadMessagesGetOneErrorEach) {
@@ -429,13 +443,17 @@ TEST(SavingServer, TfFilesRoundTripThroughTheServer) {
     c.read_text();
     const TransferFunction tf = value_tf();
     // lacuna JSON: what --tf reads, the TF exactly.
-    c.send(json{{"type", "tf_export"}, {"id", 1}, {"format", "lacuna"}, {"tf", json::parse(to_json(tf))}}.dump());
+    c.send(json{
+        {"type", "tf_export"}, {"id", 1}, {"format", "lacuna"}, {"tf", json::parse(to_json(tf))}}
+               .dump());
     const json lacuna = c.read_text();
     ASSERT_EQ(lacuna["type"], "tf_export") << lacuna.dump();
     EXPECT_EQ(lacuna["format"], "lacuna");
     EXPECT_EQ(parse_transfer_function(lacuna["text"].get<std::string>(), "t.json"), tf);
     // Slicer: the writer over the server's volume, read back by the Slicer reader.
-    c.send(json{{"type", "tf_export"}, {"id", 2}, {"format", "slicer"}, {"tf", json::parse(to_json(tf))}}.dump());
+    c.send(json{
+        {"type", "tf_export"}, {"id", 2}, {"format", "slicer"}, {"tf", json::parse(to_json(tf))}}
+               .dump());
     const json slicer = c.read_text();
     ASSERT_EQ(slicer["type"], "tf_export") << slicer.dump();
     EXPECT_EQ(read_back(slicer["text"].get<std::string>()), tf);
@@ -457,7 +475,8 @@ TEST(SavingServer, ASessionNeedsTheVolumesFile) {
     const json e = c.read_text();
     EXPECT_EQ(e["type"], "error");
     EXPECT_EQ(e["id"], 4);
-    EXPECT_NE(e["message"].get<std::string>().find("session: volume"), std::string::npos) << e.dump();
+    EXPECT_NE(e["message"].get<std::string>().find("session: volume"), std::string::npos)
+        << e.dump();
     // A screenshot needs no file.
     c.send(view_json("screenshot", 5).dump());
     bool binary = false;
@@ -500,7 +519,8 @@ TEST(SavingServer, ASavedSessionOpensToTheSameViewAndForeignOnesNameWhatDiffers)
     // Sessions the viewer cannot reproduce: one error each, naming the field.
     json doc = json::parse(saved);
     auto refused = [&](const json& d, const std::string& needle) {
-        c.send(json{{"type", "session_import"}, {"id", 9}, {"name", "x.json"}, {"text", d.dump()}}.dump());
+        c.send(json{{"type", "session_import"}, {"id", 9}, {"name", "x.json"}, {"text", d.dump()}}
+                   .dump());
         const json e = c.read_text();
         EXPECT_EQ(e["type"], "error") << d.dump();
         EXPECT_EQ(e["id"], 9);
@@ -522,6 +542,8 @@ TEST(SavingServer, ASavedSessionOpensToTheSameViewAndForeignOnesNameWhatDiffers)
     // A relative path naming the server's file is its volume.
     json relative = doc;
     relative["volume"]["path"] = server.volume_path.filename().string();
-    c.send(json{{"type", "session_import"}, {"id", 10}, {"name", "r.json"}, {"text", relative.dump()}}.dump());
+    c.send(
+        json{{"type", "session_import"}, {"id", 10}, {"name", "r.json"}, {"text", relative.dump()}}
+            .dump());
     EXPECT_EQ(c.read_text()["type"], "session_import");
 }

@@ -116,7 +116,7 @@ inline WireFrame split_frame(const std::string& msg) {
 
 // One HTTP/1.1 request; returns the response.
 inline http::response<http::string_body> http_get(uint16_t port, const std::string& target,
-                                           const std::string& host = "") {
+                                                  const std::string& host = "") {
     net::io_context ioc;
     tcp::socket s(ioc);
     tcp::resolver resolver(ioc);
@@ -129,6 +129,5 @@ inline http::response<http::string_body> http_get(uint16_t port, const std::stri
     http::read(s, b, res);
     return res;
 }
-
 
 }  // namespace lacuna::serve::test

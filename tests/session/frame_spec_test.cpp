@@ -1,13 +1,14 @@
 // FrameSpec: validate() names the field at fault (never a CLI flag), and the capabilities table
 // agrees with what the renderers do: every structure and feature the table grants renders and
 // has an effect, every one it denies is refused by validate() naming its field.
+#include "lacuna/frame_spec.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
 
 #include "lacuna/accel.h"
-#include "lacuna/frame_spec.h"
 #include "lacuna/renderer.h"
 #include "lacuna/session.h"
 #include "lacuna/synthetic.h"
@@ -61,55 +62,90 @@ TEST(FrameSpec, EachErrorNamesItsField) {
          "sampling.early_termination"},
         {Renderer::Segments, [](FrameSpec& f) { f.sampling.early_termination = 0.f; },
          "sampling.early_termination"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.zoom = 0.f; }, "camera.orbit.zoom"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.zoom = 0.f; },
+         "camera.orbit.zoom"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.fov_y_deg = 180.f; },
          "camera.orbit.fov_y_deg"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.azimuth_deg = NAN; }, "camera.orbit"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.azimuth_deg = NAN; },
+         "camera.orbit"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.pan_x = INFINITY; }, "camera.pan"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.up = {0, NAN, 1}; }, "camera.orbit.up"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.camera.orbit.up = {0, 0, 0}; }, "camera.orbit.up"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.camera.orbit.up = {0, NAN, 1};
+         },
+         "camera.orbit.up"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.camera.orbit.up = {0, 0, 0};
+         },
+         "camera.orbit.up"},
         {Renderer::RayMarcher,  // along the view: azimuth 0, elevation 0 looks along -y
          [](FrameSpec& f) {
              f.camera.orbit.azimuth_deg = f.camera.orbit.elevation_deg = 0.f;
              f.camera.orbit.up = {0, -2, 0};
          },
          "camera.orbit.up"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.background = {0, 2, 0}; }, "background"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{}; }, "structure"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::LabelOctree{}; }, "structure"},
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.background = {0, 2, 0};
+         },
+         "background"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{}; },
+         "structure"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::LabelOctree{}; },
+         "structure"},
         {Renderer::Slicer, [](FrameSpec& f) { f.structure = structure::Bitfield{}; }, "structure"},
-        {Renderer::Segments, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{}; }, "structure"},
+        {Renderer::Segments, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{}; },
+         "structure"},
         {Renderer::Segments,
          [](FrameSpec& f) {
              f.segments.mode = SegmentMode::Labels;
              f.structure = structure::MinMax{};
          },
          "structure"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::MinMax{{3, -1, true}}; },
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.structure = structure::MinMax{{3, -1, true}};
+         },
          "structure.octree.leaf_cells"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::Bitfield{{}, 7}; },
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.structure = structure::Bitfield{{}, 7};
+         },
          "structure.bits"},
-        {Renderer::Segments, [](FrameSpec& f) { f.structure = structure::LabelOctree{1, 64}; },
+        {Renderer::Segments,
+         [](FrameSpec& f) {
+             f.structure = structure::LabelOctree{1, 64};
+         },
          "structure.leaf_cells"},
         {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::Distance{0}; },
          "structure.block"},
         {Renderer::Slicer, [](FrameSpec& f) { f.structure = structure::KdTree{-1}; },
          "structure.max_boxes"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.structure = structure::KdTree{0, 0, 2.f}; },
+        {Renderer::RayMarcher,
+         [](FrameSpec& f) {
+             f.structure = structure::KdTree{0, 0, 2.f};
+         },
          "structure.min_volume"},
         {Renderer::RayMarcher,
-         [](FrameSpec& f) { f.structure = structure::KdTree{0, 0, 0.1f, 0.05f, 65}; },
+         [](FrameSpec& f) {
+             f.structure = structure::KdTree{0, 0, 0.1f, 0.05f, 65};
+         },
          "structure.max_depth"},
         {Renderer::Slicer, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{2.f}; },
          "structure.coalesce"},
-        {Renderer::Slicer, [](FrameSpec& f) { f.structure = structure::GrowingBoxes{0.25f, 0.f}; },
+        {Renderer::Slicer,
+         [](FrameSpec& f) {
+             f.structure = structure::GrowingBoxes{0.25f, 0.f};
+         },
          "structure.coalesce_edge"},
         {Renderer::Slicer, [](FrameSpec& f) { f.features.shading = ShadingModel::Phong; },
          "features.shading"},
         {Renderer::Segments, [](FrameSpec& f) { f.features.clip_planes.push_back({}); },
          "features.clip_planes"},
         {Renderer::Slicer, [](FrameSpec& f) { f.features.crop = true; }, "features.crop"},
-        {Renderer::Segments, [](FrameSpec& f) { f.features.blend = BlendMode::Mip; }, "features.blend"},
+        {Renderer::Segments, [](FrameSpec& f) { f.features.blend = BlendMode::Mip; },
+         "features.blend"},
         {Renderer::Slicer, [](FrameSpec& f) { f.features.jitter = true; }, "features.jitter"},
         {Renderer::Slicer, [](FrameSpec& f) { f.features.gradient_opacity.enabled = true; },
          "features.gradient_opacity"},
@@ -120,12 +156,15 @@ TEST(FrameSpec, EachErrorNamesItsField) {
         {Renderer::RayMarcher, [](FrameSpec& f) { f.slicer.occlusion = true; }, "slicer.occlusion"},
         {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_threshold = 0.f; },
          "slicer.occlusion_threshold"},
-        {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_map = 5000; }, "slicer.occlusion_map"},
+        {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_map = 5000; },
+         "slicer.occlusion_map"},
         {Renderer::Slicer, [](FrameSpec& f) { f.slicer.occlusion_updates = -1; },
          "slicer.occlusion_updates"},
         {Renderer::Segments, [](FrameSpec& f) { f.segments.tint = 2.f; }, "segments.tint"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.phong.power = -1.f; }, "features.phong"},
-        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.pbr.roughness = 0.f; }, "features.pbr"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.phong.power = -1.f; },
+         "features.phong"},
+        {Renderer::RayMarcher, [](FrameSpec& f) { f.features.pbr.roughness = 0.f; },
+         "features.pbr"},
         {Renderer::RayMarcher,
          [](FrameSpec& f) {
              f.features.gradient_opacity.enabled = true;
@@ -146,7 +185,9 @@ TEST(FrameSpec, EachErrorNamesItsField) {
         {Renderer::RayMarcher, [](FrameSpec& f) { f.features.shadows.light_volume_stride = 0; },
          "features.shadows.light_volume_stride"},
         {Renderer::RayMarcher,
-         [](FrameSpec& f) { f.features.clip_planes.push_back({{0, 0, 0}, 1.f}); },
+         [](FrameSpec& f) {
+             f.features.clip_planes.push_back({{0, 0, 0}, 1.f});
+         },
          "features.clip_planes"},
         {Renderer::RayMarcher,
          [](FrameSpec& f) {
@@ -185,7 +226,8 @@ TEST(FrameSpec, StructureNamesAndKindsRoundTrip) {
     o.bitfield_bits = 32;
     o.initial_level = 2;
     o.bidirectional = false;
-    const auto back = accel_options(structure_of(AccelKind::Bitfield, o), Interpolation::Nearest, 3);
+    const auto back =
+        accel_options(structure_of(AccelKind::Bitfield, o), Interpolation::Nearest, 3);
     ASSERT_TRUE(back);
     EXPECT_EQ(back->leaf_cells, 4);
     EXPECT_EQ(back->bitfield_bits, 32);
@@ -207,7 +249,8 @@ TEST(FrameSpec, ParseStructureIsTheRegistrysNamesForEveryRenderer) {
             taken = true;
             // The segment renderer reads "bitfield" as its label octree.
             if (cap.renderer == Renderer::Segments && name == "bitfield") continue;
-            EXPECT_EQ(parse_structure(name, cap.renderer), s) << name << " " << to_string(cap.renderer);
+            EXPECT_EQ(parse_structure(name, cap.renderer), s)
+                << name << " " << to_string(cap.renderer);
         }
         EXPECT_TRUE(taken) << name;
     }
@@ -231,7 +274,8 @@ TEST(FrameSpec, ParseStructureIsTheRegistrysNamesForEveryRenderer) {
             ADD_FAILURE() << "'" << bad << "' was accepted";
         } catch (const FrameError& e) {
             EXPECT_EQ(e.field(), "structure");
-            EXPECT_NE(e.expected().find(std::string("'") + bad + "'"), std::string::npos) << e.what();
+            EXPECT_NE(e.expected().find(std::string("'") + bad + "'"), std::string::npos)
+                << e.what();
             for (const Structure& s : all_structures())
                 EXPECT_NE(e.expected().find(structure_name(s)), std::string::npos) << e.what();
         }
@@ -270,7 +314,8 @@ TEST(FrameSpec, LibraryErrorsBelowValidateNameFieldsNotFlags) {
     EXPECT_EQ(field_of([&] { make_accel(AccelKind::Bitfield, vol, ao); }), "structure.bits");
     ao = {};
     ao.leaf_cells = 3;
-    EXPECT_EQ(field_of([&] { make_accel(AccelKind::MinMax, vol, ao); }), "structure.octree.leaf_cells");
+    EXPECT_EQ(field_of([&] { make_accel(AccelKind::MinMax, vol, ao); }),
+              "structure.octree.leaf_cells");
     ao = {};
     ao.distance_block = 0;
     EXPECT_EQ(field_of([&] { make_accel(AccelKind::Chebyshev, vol, ao); }), "structure.block");
@@ -310,9 +355,11 @@ TEST(Capabilities, EveryStructureTheTableGrantsRendersAndEveryOtherIsRefused) {
             FrameSpec f = on(cap.renderer, st);
             if (cap.takes(st)) {
                 const FrameResult r = session->render(f);
-                EXPECT_EQ(r.image.width, 24) << to_string(cap.renderer) << " " << structure_name(st);
+                EXPECT_EQ(r.image.width, 24)
+                    << to_string(cap.renderer) << " " << structure_name(st);
             } else {
-                EXPECT_EQ(blamed(f), "structure") << to_string(cap.renderer) << " " << structure_name(st);
+                EXPECT_EQ(blamed(f), "structure")
+                    << to_string(cap.renderer) << " " << structure_name(st);
                 EXPECT_THROW(session->render(f), FrameError);
             }
         }
@@ -326,29 +373,47 @@ std::pair<FrameSpec, FrameSpec> with_feature(Renderer r, Feature feat) {
     base.sampling.early_termination = std::nullopt;
     FrameSpec f = base;
     switch (feat) {
-        case Feature::Shading: f.features.shading = ShadingModel::Phong; break;
-        case Feature::GradientOpacity: f.features.gradient_opacity = {true, 5.f, 50.f}; break;
+        case Feature::Shading:
+            f.features.shading = ShadingModel::Phong;
+            break;
+        case Feature::GradientOpacity:
+            f.features.gradient_opacity = {true, 5.f, 50.f};
+            break;
         case Feature::Shadows:
             base.features.shading = f.features.shading = ShadingModel::Phong;
             base.features.light.kind = f.features.light.kind = LightKind::Directional;
             base.features.light.direction = f.features.light.direction = {1, 0, 0};
             f.features.shadows.enabled = true;
             break;
-        case Feature::ClipPlanes: f.features.clip_planes.push_back({{1, 0, 0}, 10.f}); break;
+        case Feature::ClipPlanes:
+            f.features.clip_planes.push_back({{1, 0, 0}, 10.f});
+            break;
         case Feature::Crop:
             f.features.crop = true;
             f.features.crop_box = {{0, 0, 0}, {8, 17, 15}};
             break;
-        case Feature::Blend: f.features.blend = BlendMode::Mip; break;
-        case Feature::Jitter: f.features.jitter = true; break;
+        case Feature::Blend:
+            f.features.blend = BlendMode::Mip;
+            break;
+        case Feature::Jitter:
+            f.features.jitter = true;
+            break;
         case Feature::TwoTfs:
             base.features.clip_planes = f.features.clip_planes = {{{1, 0, 0}, 10.f}};
             f.two_tfs = true;
             break;
-        case Feature::Nearest: f.sampling.interpolation = Interpolation::Nearest; break;
-        case Feature::EarlyTermination: f.sampling.early_termination = 0.5f; break;
-        case Feature::SampleCounts: f.count_samples = true; break;
-        case Feature::Occlusion: f.slicer.occlusion = true; break;
+        case Feature::Nearest:
+            f.sampling.interpolation = Interpolation::Nearest;
+            break;
+        case Feature::EarlyTermination:
+            f.sampling.early_termination = 0.5f;
+            break;
+        case Feature::SampleCounts:
+            f.count_samples = true;
+            break;
+        case Feature::Occlusion:
+            f.slicer.occlusion = true;
+            break;
     }
     return {base, f};
 }
@@ -365,7 +430,8 @@ TEST(Capabilities, EveryFeatureTheTableGrantsHasAnEffectAndEveryOtherIsRefused) 
                 continue;
             }
             const FrameResult a = session->render(base), b = session->render(f);
-            const bool effect = a.image.rgba != b.image.rgba || a.stats.samples != b.stats.samples ||
+            const bool effect = a.image.rgba != b.image.rgba ||
+                                a.stats.samples != b.stats.samples ||
                                 a.sample_counts.size() != b.sample_counts.size() ||
                                 (b.slicer && b.slicer->desired_updates > 0);
             EXPECT_TRUE(effect) << what << ": the table grants it, the renderer ignores it";

@@ -1,6 +1,8 @@
 // Session: a frame through the session is the frame of the hand-wired renderers byte for byte;
 // a TF change through it gives the image of a fresh session with that TF (the structures catch
 // up); structures are built once and reused across frames and TF changes.
+#include "lacuna/session.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include "lacuna/orientation.h"
 #include "lacuna/renderer.h"
 #include "lacuna/segments.h"
-#include "lacuna/session.h"
 #include "lacuna/synthetic.h"
 #include "slice/box_sources.h"
 #include "slice/slice_renderer.h"
@@ -93,7 +94,8 @@ TEST(Session, RayMarcherFramesAreTheHandWiredFrames) {
             if (refine) session.refine();
             const FrameResult r = session.render(f);
             EXPECT_TRUE(r.image.rgba == direct.image.rgba) << to_string(k) << " refine " << refine;
-            EXPECT_EQ(r.stats.samples, direct.stats.samples) << to_string(k) << " refine " << refine;
+            EXPECT_EQ(r.stats.samples, direct.stats.samples)
+                << to_string(k) << " refine " << refine;
         }
     }
 }
@@ -137,8 +139,9 @@ TEST(Session, SlicerFramesAreTheHandWiredFrames) {
     const TransferLut lut = discretise(window(0.3, 0.7), vol.vis_range());
     Session session(blobs(), 1);
     session.set_transfer_function(window(0.3, 0.7));
-    const std::pair<Structure, std::string> sources[] = {
-        {structure::None{}, "none"}, {structure::KdTree{}, "kdtree"}, {structure::GrowingBoxes{}, "boxes"}};
+    const std::pair<Structure, std::string> sources[] = {{structure::None{}, "none"},
+                                                         {structure::KdTree{}, "kdtree"},
+                                                         {structure::GrowingBoxes{}, "boxes"}};
     for (const auto& [st, name] : sources) {
         FrameSpec f = spec(st);
         f.renderer = Renderer::Slicer;
@@ -201,7 +204,8 @@ TEST(Session, SlicerOcclusionFramesAreTheHandWiredFramesAcrossAnOrbit) {
                 o.occlusion.mode = mode;
                 o.occlusion.updates = 3;
                 o.occlusion.map_size = 16;
-                const Camera cam = Camera::orbit(slicer.bounds(), f.camera.orbit, f.width, f.height);
+                const Camera cam =
+                    Camera::orbit(slicer.bounds(), f.camera.orbit, f.width, f.height);
                 const SliceResult hand = slicer.render(cam, o, adaptive ? &controller : nullptr);
                 const FrameResult r = session.render(f);
                 const std::string what = to_string(mode) + (adaptive ? " adaptive" : "") +
@@ -234,7 +238,8 @@ TEST(Session, SlicerOcclusionFramesAreTheHandWiredFramesAcrossAnOrbit) {
     session.render(other);
     for (int view = 0; view < 12; ++view) {
         f.camera.orbit.azimuth_deg = 30.f * float(view);
-        EXPECT_EQ(session.render(f).slicer->desired_updates, fresh.render(f).slicer->desired_updates)
+        EXPECT_EQ(session.render(f).slicer->desired_updates,
+                  fresh.render(f).slicer->desired_updates)
             << view;
     }
 }
@@ -349,7 +354,8 @@ TEST(Session, RefusesFramesItCannotRender) {
 TEST(Session, PanZeroIsTheOrbitCameraAndPanMovesIt) {
     Session session(blobs(), 1);
     FrameSpec f = spec(structure::None{});
-    const Camera orbit = Camera::orbit(world_bounds(session.volume()), f.camera.orbit, f.width, f.height);
+    const Camera orbit =
+        Camera::orbit(world_bounds(session.volume()), f.camera.orbit, f.width, f.height);
     EXPECT_EQ(to_string(session.camera(f)), to_string(orbit));
     f.camera.pan_x = 0.25f;
     EXPECT_NE(to_string(session.camera(f)), to_string(orbit));
@@ -382,7 +388,7 @@ TEST(Session, UpRollsTheCameraAndItsNegationTurnsTheImage) {
                 diff += std::abs(p - q);
                 nonzero += p != 0;
             }
-    EXPECT_GT(nonzero, 40);  // the frame shows something
+    EXPECT_GT(nonzero, 40);                       // the frame shows something
     EXPECT_LE(double(diff) / (w * h * 3), 0.05);  // the turned image, up to a lattice rounding
     f.camera.orbit.up = {1, 0, 1};
     EXPECT_FALSE(session.render(f).image.rgba == a.image.rgba);
@@ -456,8 +462,8 @@ TEST(Session, EveryStructureGivesTheNoneImageOnEveryRendererThatTakesIt) {
                     f.structure = st;
                     const FrameResult r = session.render(f);
                     EXPECT_TRUE(r.image.rgba == reference.image.rgba)
-                        << to_string(cap.renderer) << " " << structure_name(st) << " sparse " << sparse
-                        << " refined " << refined;
+                        << to_string(cap.renderer) << " " << structure_name(st) << " sparse "
+                        << sparse << " refined " << refined;
                     EXPECT_LE(r.stats.samples, reference.stats.samples) << structure_name(st);
                 }
             }

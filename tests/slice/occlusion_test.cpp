@@ -36,7 +36,8 @@ struct Scene {
 };
 
 // Dense scenes: the Marschner-Lobb signal (visible almost everywhere) and a solid sphere.
-Scene dense(Vec3i dims, VoxelType t, uint32_t seed, SyntheticKind kind = SyntheticKind::MarschnerLobb) {
+Scene dense(Vec3i dims, VoxelType t, uint32_t seed,
+            SyntheticKind kind = SyntheticKind::MarschnerLobb) {
     SyntheticOptions o;
     o.dims = dims;
     o.type = t;
@@ -59,9 +60,9 @@ TEST(OcclusionClipping, ThresholdOneIsByteIdenticalAndBelowIsBounded) {
     Rng rng{99};
     uint64_t skipped_views = 0;
     for (int vol = 0; vol < 3; ++vol) {
-        const Scene s = dense({28 + vol * 3, 26, 30 - vol * 2},
-                              vol == 1 ? VoxelType::Int16 : VoxelType::UInt8, 11 + vol,
-                              vol == 2 ? SyntheticKind::Sphere : SyntheticKind::MarschnerLobb);
+        const Scene s =
+            dense({28 + vol * 3, 26, 30 - vol * 2}, vol == 1 ? VoxelType::Int16 : VoxelType::UInt8,
+                  11 + vol, vol == 2 ? SyntheticKind::Sphere : SyntheticKind::MarschnerLobb);
         SliceRenderer r(s.volume);
         r.set_transfer_function(s.lut);
         AccelOptions ao;
@@ -98,8 +99,8 @@ TEST(OcclusionClipping, ThresholdOneIsByteIdenticalAndBelowIsBounded) {
                 ASSERT_LE(worst, 0.05f + 1e-5f) << what;
                 int worst8 = 0;
                 for (size_t i = 0; i < ref.image.rgba.size(); ++i)
-                    worst8 = std::max(worst8, std::abs(int(approx.image.rgba[i]) -
-                                                       int(ref.image.rgba[i])));
+                    worst8 = std::max(worst8,
+                                      std::abs(int(approx.image.rgba[i]) - int(ref.image.rgba[i])));
                 ASSERT_LE(worst8, 14) << what;  // ceil(255 * 0.05) + rounding
                 if (mode == OcclusionMode::MapOnly) {
                     ASSERT_EQ(approx.image.rgba, ref.image.rgba) << what;
@@ -218,8 +219,10 @@ TEST(AdaptiveUpdates, PollsEveryNthFrameAndMovesTowardTheBest) {
     std::vector<int> polled;
     for (int f = 0; f < 400; ++f) {
         const int k = a.desired();
-        if (f % 10 != 0) EXPECT_EQ(k, a.centre()) << "frame " << f;
-        else polled.push_back(k);
+        if (f % 10 != 0)
+            EXPECT_EQ(k, a.centre()) << "frame " << f;
+        else
+            polled.push_back(k);
         a.report(skipped(k), k);
     }
     EXPECT_EQ(a.centre(), 5);

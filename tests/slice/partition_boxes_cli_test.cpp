@@ -14,14 +14,18 @@ namespace {
 namespace fs = std::filesystem;
 
 using CliRun = lacuna::test::CliResult;
-std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
+std::string slurp(const fs::path& p) {
+    return lacuna::test::slurp_file(p);
+}
 
 fs::path temp_dir() {
     static const fs::path dir = lacuna::test::cli_temp_dir("boxes");
     return dir;
 }
 
-CliRun run_cli(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliRun run_cli(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 const fs::path& volume() {
     static fs::path v = [] {

@@ -2,13 +2,14 @@
 // Sutherland-Hodgman clip of each plane by the box: same vertices, same cyclic order (the
 // shoelace area of the incremental order equals the hull's area), on random boxes, random and
 // axis-aligned normals, thin boxes, planes through vertices.
+#include "slice/polygon.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
 #include "common/rng.h"
-#include "slice/polygon.h"
 
 namespace lacuna {
 namespace {
@@ -75,8 +76,8 @@ void check_box(Vec3d lo, Vec3d hi, Vec3d n, double dc, const std::string& what,
         s.next(inc);
         const SlicePolygon ref = clip_plane_against_box(lo, hi, n, c);
         if (ref.count >= 3 && std::abs(area(dedupe(ref, 1e-9 * scale), n)) > 1e-6 * scale * scale) {
-            ASSERT_GE(inc.count, 3) << what << " plane " << planes << " c " << c << " ref "
-                                    << to_string(ref);
+            ASSERT_GE(inc.count, 3)
+                << what << " plane " << planes << " c " << c << " ref " << to_string(ref);
             ++non_empty;
         }
         if (inc.count == 0 && ref.count == 0) continue;

@@ -31,7 +31,8 @@ class RandomBspSource final : public BoxSource {
                     for (int i = n.box.lo[0]; i < n.box.hi[0] && !n.visible; ++i) {
                         float lo = INFINITY, hi = -INFINITY;
                         for (int c = 0; c < 8; ++c) {
-                            const float x = m_volume.value(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2));
+                            const float x =
+                                m_volume.value(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2));
                             lo = std::min(lo, x);
                             hi = std::max(hi, x);
                         }
@@ -42,12 +43,14 @@ class RandomBspSource final : public BoxSource {
     }
     std::vector<CellBox> boxes_front_to_back(Vec3f eye) const override {
         std::vector<CellBox> out;
-        walk(0, [&](const Node& n) { return eye[n.axis] < float(n.plane); }, out);
+        walk(
+            0, [&](const Node& n) { return eye[n.axis] < float(n.plane); }, out);
         return out;
     }
     std::vector<CellBox> boxes_front_to_back_along(Vec3f dir) const override {
         std::vector<CellBox> out;
-        walk(0, [&](const Node& n) { return dir[n.axis] > 0.f; }, out);
+        walk(
+            0, [&](const Node& n) { return dir[n.axis] > 0.f; }, out);
         return out;
     }
     const char* name() const override { return "random-bsp"; }

@@ -3,24 +3,30 @@
 // runs on a tiny orbit.
 #include <gtest/gtest.h>
 
-#include "apps/cli_run.h"
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "apps/cli_run.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
 using CliRun = lacuna::test::CliResult;
-std::string slurp(const fs::path& p) { return lacuna::test::slurp_file(p); }
+std::string slurp(const fs::path& p) {
+    return lacuna::test::slurp_file(p);
+}
 using lacuna::test::expect_one_line_error;
 
-fs::path temp_dir() { return lacuna::test::cli_temp_dir("slice-cli"); }
+fs::path temp_dir() {
+    return lacuna::test::cli_temp_dir("slice-cli");
+}
 
-CliRun run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliRun run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 const fs::path& volume() {
     static fs::path p = [] {
@@ -35,12 +41,14 @@ const fs::path& volume() {
 TEST(SliceCli, EveryBoxSourceAndThresholdOneWriteTheBasicBytes) {
     const std::string v = volume().string();
     const fs::path ref = temp_dir() / "basic.png";
-    CliRun r = run("render " + v + " --tf mr-default --size 40 --renderer slice --out " + ref.string());
+    CliRun r =
+        run("render " + v + " --tf mr-default --size 40 --renderer slice --out " + ref.string());
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("slice renderer"), std::string::npos) << r.out;
-    for (const std::string extra : {"--accel kdtree", "--accel kdtree --occlusion --occlusion-threshold 1",
-                                    "--accel kdtree --ortho --azimuth 100", "--threads 1",
-                                    "--accel boxes", "--accel boxes --occlusion --occlusion-threshold 1"}) {
+    for (const std::string extra :
+         {"--accel kdtree", "--accel kdtree --occlusion --occlusion-threshold 1",
+          "--accel kdtree --ortho --azimuth 100", "--threads 1", "--accel boxes",
+          "--accel boxes --occlusion --occlusion-threshold 1"}) {
         const fs::path png = temp_dir() / "x.png";
         r = run("render " + v + " --tf mr-default --size 40 --renderer slice " + extra + " --out " +
                 png.string());
@@ -54,7 +62,8 @@ TEST(SliceCli, EveryBoxSourceAndThresholdOneWriteTheBasicBytes) {
 TEST(SliceCli, NearestSamplesAreExactForEveryBoxSource) {
     const std::string v = volume().string();
     const fs::path ref = temp_dir() / "basic-nearest.png", tri = temp_dir() / "basic-tri.png";
-    CliRun r = run("render " + v + " --tf mr-default --size 40 --renderer slice --interpolation nearest --out " +
+    CliRun r = run("render " + v +
+                   " --tf mr-default --size 40 --renderer slice --interpolation nearest --out " +
                    ref.string());
     ASSERT_EQ(r.code, 0) << r.err;
     r = run("render " + v + " --tf mr-default --size 40 --renderer slice --out " + tri.string());
@@ -63,8 +72,9 @@ TEST(SliceCli, NearestSamplesAreExactForEveryBoxSource) {
     for (const std::string extra : {"--accel kdtree", "--accel boxes",
                                     "--accel kdtree --occlusion --occlusion-threshold 1"}) {
         const fs::path png = temp_dir() / "xn.png";
-        r = run("render " + v + " --tf mr-default --size 40 --renderer slice --interpolation nearest " +
-                extra + " --out " + png.string());
+        r = run("render " + v +
+                " --tf mr-default --size 40 --renderer slice --interpolation nearest " + extra +
+                " --out " + png.string());
         ASSERT_EQ(r.code, 0) << extra << ": " << r.err;
         EXPECT_EQ(slurp(png), slurp(ref)) << extra;
     }
@@ -77,8 +87,9 @@ TEST(SliceCli, InvalidCombinationsAreOneLineExit2) {
     expect_one_line_error(run(base + "--occlusion --out x.png"), "--renderer slice");
     expect_one_line_error(run(base + "--renderer slice --occlusion-threshold 0.9 --out x.png"),
                           "--occlusion");
-    expect_one_line_error(run(base + "--renderer slice --occlusion --occlusion-threshold 1.5 --out x.png"),
-                          "--occlusion-threshold");
+    expect_one_line_error(
+        run(base + "--renderer slice --occlusion --occlusion-threshold 1.5 --out x.png"),
+        "--occlusion-threshold");
     expect_one_line_error(run(base + "--renderer slice --occlusion --occlusion-map 0 --out x.png"),
                           "--occlusion-map");
     expect_one_line_error(run(base + "--renderer slice --accel bitfield --out x.png"), "--accel");

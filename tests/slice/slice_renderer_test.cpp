@@ -3,6 +3,8 @@
 // volumes, random orthographic and perspective cameras, eyes inside the volume); the same bytes
 // for any thread count and tile size; Beer-Lambert through a homogeneous slab; close to the ray
 // marcher.
+#include "slice/slice_renderer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,13 +17,12 @@
 #include "lacuna/synthetic.h"
 #include "slice/box_sources.h"
 #include "slice/random_bsp_source.h"
-#include "slice/slice_renderer.h"
 
 namespace lacuna {
 namespace {
 
-using test::Rng;
 using test::RandomBspSource;
+using test::Rng;
 
 TransferFunction band_tf(double a, double b, float opacity) {
     TransferFunction tf;
@@ -76,7 +77,8 @@ std::vector<VolumeCase> cases() {
     add("tree", SyntheticKind::Tree, {23, 19, 26}, VoxelType::UInt8, band_tf(0.3, 0.6, 0.5f));
     add("blobs-int16", SyntheticKind::NoiseBlobs, {21, 24, 17}, VoxelType::Int16,
         band_tf(0.2, 0.9, 0.3f));
-    add("sheets", SyntheticKind::ThinSheets, {19, 17, 21}, VoxelType::UInt8, band_tf(0.9, 1.0, 0.8f));
+    add("sheets", SyntheticKind::ThinSheets, {19, 17, 21}, VoxelType::UInt8,
+        band_tf(0.9, 1.0, 0.8f));
     add("checker-float", SyntheticKind::Checkerboard, {12, 13, 11}, VoxelType::Float32,
         band_tf(0.7, 1.0, 0.4f));
     add("bins", SyntheticKind::BinBoundaries, {18, 16, 20}, VoxelType::UInt16,
@@ -100,7 +102,8 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
         bsp.set_transfer_function(c.lut);
         for (int view = 0; view < 10; ++view) {
             // View 5: eye inside the volume; view 7: voxels smaller than a pixel.
-            const Camera cam = random_camera(r, rng, view == 7 ? 23 : 40, view == 5, view == 7 ? 0.3f : 0.f);
+            const Camera cam =
+                random_camera(r, rng, view == 7 ? 23 : 40, view == 5, view == 7 ? 0.3f : 0.f);
             SliceOptions o;
             o.keep_float = true;
             o.ert = view % 2 ? 0.95f : kNoEarlyTermination;
@@ -108,7 +111,8 @@ TEST(SliceRenderer, EveryBoxSourceGivesTheBasicBytes) {
             r.set_box_source(nullptr);
             const SliceResult basic = r.render(cam, o);
             ASSERT_GT(basic.stats.samples, 0u) << c.name;
-            const std::string what = c.name + " view " + std::to_string(view) + " " + to_string(cam);
+            const std::string what =
+                c.name + " view " + std::to_string(view) + " " + to_string(cam);
             r.set_box_source(kd.get());
             const SliceResult a = r.render(cam, o);
             expect_same(a, basic, what + " kdtree");

@@ -139,8 +139,8 @@ TEST(LutRange, FloatDataWiderThanFloatIsRejected) {
 // an inf sample. The boundary refuses non-constant float data beyond 2^127, and every sample of
 // data up to it, corners at both ends, is finite.
 TEST(LutRange, FloatDataWithinAnUlpOfFloatsEndIsRejected) {
-    Volume v = float_volume({1.1630922e38f, 1.1630922e38f, 1.1630922e38f, 1.1630922e38f, kMax,
-                             kMax, kMax, kMax});
+    Volume v = float_volume(
+        {1.1630922e38f, 1.1630922e38f, 1.1630922e38f, 1.1630922e38f, kMax, kMax, kMax, kMax});
     try {
         v.compute_range("edge.nii");
         FAIL() << "accepted";

@@ -27,8 +27,9 @@ TEST(ParserFuzzRegression, SlicerCountBeyondIntegersIsAnError) {
     // fuzz_slicer_xml, fuzz_slicer_vp: a point count of 4.34e39 was converted to int64_t (UB).
     const std::string vp =
         "1\n1\n0.9\n0.1\n0.2\n10\n4.34e39 0 0 255 1\n4 0 1 255 1\n8 0 0 0 0 255 1 1 1\n";
-    EXPECT_NE(error_of([&] { parse_slicer_vp(vp, "x.vp"); })
-                  .find("x.vp: line 7 (scalar opacity): expected 4.34e+39 numbers after the count"),
+    EXPECT_NE(error_of([&] {
+                  parse_slicer_vp(vp, "x.vp");
+              }).find("x.vp: line 7 (scalar opacity): expected 4.34e+39 numbers after the count"),
               std::string::npos);
     const std::string xml = R"(<MRML><VolumeProperty name="A" interpolation="1" shade="0"
         scalarOpacity="1e300 0 0" gradientOpacity="4 0 1 255 1"
@@ -39,8 +40,9 @@ TEST(ParserFuzzRegression, SlicerCountBeyondIntegersIsAnError) {
 
 TEST(ParserFuzzRegression, SlicerVpJsonNumberBeyondDoubleIsAnError) {
     // fuzz_slicer_vp_json: nlohmann's out_of_range.406 (1e999) escaped as std::terminate.
-    EXPECT_NE(error_of([] { parse_slicer_vp_json("{\"volumeProperties\": [1e999]}", "x.vp.json"); })
-                  .find("x.vp.json: json: not valid JSON"),
+    EXPECT_NE(error_of([] {
+                  parse_slicer_vp_json("{\"volumeProperties\": [1e999]}", "x.vp.json");
+              }).find("x.vp.json: json: not valid JSON"),
               std::string::npos);
 }
 

@@ -29,10 +29,11 @@ TEST(Presets, ListsAllRequiredNames) {
 
 // 3D Slicer's presets (capitalised names, value domain) are checked below; the rules of
 // lacuna's own presets hold for the rest.
-const char* const kSlicerNames[] = {"CT-AAA", "CT-Bone", "CT-Lung", "CT-Soft-Tissue",
+const char* const kSlicerNames[] = {"CT-AAA", "CT-Bone",    "CT-Lung",  "CT-Soft-Tissue",
                                     "CT-MIP", "MR-Default", "MR-Angio", "MR-MIP"};
 bool is_slicer(const std::string& name) {
-    return std::find(std::begin(kSlicerNames), std::end(kSlicerNames), name) != std::end(kSlicerNames);
+    return std::find(std::begin(kSlicerNames), std::end(kSlicerNames), name) !=
+           std::end(kSlicerNames);
 }
 std::vector<std::string> lacuna_preset_names() {
     std::vector<std::string> out;
@@ -90,8 +91,9 @@ TEST(Presets, SlicerPresetsHoldSlicersValues) {
     // CT-Bone: scalarOpacity="8 -3024 0 -16.4458 0 641.385 0.715686 3071 0.705882", shade 1,
     // ambient 0.1, diffuse 0.9, specular 0.2, specularPower 10.
     const TransferFunction bone = preset("CT-Bone");
-    EXPECT_EQ(bone.opacity, (std::vector<OpacityPoint>{
-                                {-3024, 0.f}, {-16.4458, 0.f}, {641.385, 0.715686f}, {3071, 0.705882f}}));
+    EXPECT_EQ(bone.opacity,
+              (std::vector<OpacityPoint>{
+                  {-3024, 0.f}, {-16.4458, 0.f}, {641.385, 0.715686f}, {3071, 0.705882f}}));
     EXPECT_EQ(bone.color.size(), 4u);
     EXPECT_EQ(bone.color[2], (ColorPoint{641.385, 0.905882f, 0.815686f, 0.552941f}));
     ASSERT_TRUE(bone.rendering.shading);

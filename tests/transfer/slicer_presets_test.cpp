@@ -102,7 +102,8 @@ TEST(SlicerPresets, VpAndVpJsonCarryTheSameFields) {
     ASSERT_TRUE(js.effective_range);
     EXPECT_EQ(js.effective_range->min, xml.effective_range->min);
     EXPECT_EQ(js.effective_range->max, xml.effective_range->max);
-    EXPECT_EQ(resolve_slicer_preset(kData + "lacuna-ct.vp.json#0").scalar_opacity, js.scalar_opacity);
+    EXPECT_EQ(resolve_slicer_preset(kData + "lacuna-ct.vp.json#0").scalar_opacity,
+              js.scalar_opacity);
 }
 
 TEST(SlicerPresets, ConvertsToTheSameTfAsOurJson) {
@@ -137,7 +138,8 @@ TEST(SlicerPresets, ConvertsToTheSameTfAsOurJson) {
     EXPECT_EQ(mr.rendering.gradient_opacity,
               (std::vector<OpacityPoint>{{0, 0.5f}, {20, 1.f}, {255, 1.f}}));
     // .vp.json's disableGradientOpacity drops it.
-    SlicerVolumeProperty off = resolve_slicer_preset("slicer:" + kData + "slicer-presets.xml#Lacuna-MR-Brain");
+    SlicerVolumeProperty off =
+        resolve_slicer_preset("slicer:" + kData + "slicer-presets.xml#Lacuna-MR-Brain");
     off.gradient_opacity_enabled = false;
     EXPECT_TRUE(to_transfer_function(off).rendering.gradient_opacity.empty());
 }
@@ -171,7 +173,8 @@ TEST(SlicerPresets, MalformedEntriesNameFileEntryAndField) {
         {xml_with(ok_op + " " + ok_color + " interpolation=\"2\""),
          "interpolation: expected 0 (nearest) or 1 (linear), got '2'"},
         {"<MRML><VolumeProperty " + ok_op + "/></MRML>", "expected a non-empty name attribute"},
-        {"<MRML><VolumeProperty name=\"a\" " + ok_op + "></MRML>", "xml: not well-formed XML at line 1"},
+        {"<MRML><VolumeProperty name=\"a\" " + ok_op + "></MRML>",
+         "xml: not well-formed XML at line 1"},
         {"<MRML></MRML>", "VolumeProperty: expected at least one <VolumeProperty> element"},
     };
     for (const Case& c : cases) {
@@ -183,14 +186,18 @@ TEST(SlicerPresets, MalformedEntriesNameFileEntryAndField) {
 }
 
 TEST(SlicerPresets, MalformedVpAndVpJson) {
-    const std::string good = "1\n1\n0.9\n0.1\n0.2\n10\n4 0 0 255 1\n4 0 1 255 1\n8 0 0 0 0 255 1 1 1\n";
+    const std::string good =
+        "1\n1\n0.9\n0.1\n0.2\n10\n4 0 0 255 1\n4 0 1 255 1\n8 0 0 0 0 255 1 1 1\n";
     EXPECT_EQ(parse_slicer_vp(good, "x.vp").scalar_opacity.size(), 2u);
-    EXPECT_NE(error_of([&] { parse_slicer_vp("1\n1\n0.9\n", "x.vp"); }).find("x.vp: lines: expected 9 lines"),
+    EXPECT_NE(error_of([&] {
+                  parse_slicer_vp("1\n1\n0.9\n", "x.vp");
+              }).find("x.vp: lines: expected 9 lines"),
               std::string::npos);
     std::string bad = good;
     bad.replace(bad.find("4 0 0 255 1"), 11, "4 0 0 255");
-    EXPECT_NE(error_of([&] { parse_slicer_vp(bad, "x.vp"); })
-                  .find("x.vp: line 7 (scalar opacity): expected 4 numbers after the count, got 3"),
+    EXPECT_NE(error_of([&] {
+                  parse_slicer_vp(bad, "x.vp");
+              }).find("x.vp: line 7 (scalar opacity): expected 4 numbers after the count, got 3"),
               std::string::npos);
 
     auto json_error = [](const std::string& component) {
@@ -199,27 +206,38 @@ TEST(SlicerPresets, MalformedVpAndVpJson) {
                                  "x.vp.json");
         });
     };
-    const std::string op = "\"scalarOpacity\": {\"points\": [{\"x\": 0, \"y\": 0, \"midpoint\": 0.5, \"sharpness\": 0}]}";
-    const std::string col = "\"rgbTransferFunction\": {\"points\": [{\"x\": 0, \"color\": [1, 1, 1], \"midpoint\": 0.5, \"sharpness\": 0}]}";
+    const std::string op =
+        "\"scalarOpacity\": {\"points\": [{\"x\": 0, \"y\": 0, \"midpoint\": 0.5, \"sharpness\": "
+        "0}]}";
+    const std::string col =
+        "\"rgbTransferFunction\": {\"points\": [{\"x\": 0, \"color\": [1, 1, 1], \"midpoint\": "
+        "0.5, \"sharpness\": 0}]}";
     EXPECT_EQ(json_error("{" + op + ", " + col + "}"), "");
-    EXPECT_NE(json_error("{" + col + "}").find(
-                  "x.vp.json: volumeProperties[0].components[0].scalarOpacity: missing"),
+    EXPECT_NE(json_error("{" + col + "}")
+                  .find("x.vp.json: volumeProperties[0].components[0].scalarOpacity: missing"),
               std::string::npos);
-    EXPECT_NE(json_error("{\"scalarOpacity\": {\"points\": [{\"x\": 0, \"y\": 0, \"midpoint\": 0.3, "
-                         "\"sharpness\": 0}]}, " + col + "}")
-                  .find("scalarOpacity.points[0]: expected midpoint 0.5 and sharpness 0"),
-              std::string::npos);
-    EXPECT_NE(json_error("{" + op + ", \"rgbTransferFunction\": {\"points\": [{\"x\": 0, \"color\": "
+    EXPECT_NE(
+        json_error("{\"scalarOpacity\": {\"points\": [{\"x\": 0, \"y\": 0, \"midpoint\": 0.3, "
+                   "\"sharpness\": 0}]}, " +
+                   col + "}")
+            .find("scalarOpacity.points[0]: expected midpoint 0.5 and sharpness 0"),
+        std::string::npos);
+    EXPECT_NE(json_error("{" + op +
+                         ", \"rgbTransferFunction\": {\"points\": [{\"x\": 0, \"color\": "
                          "[1, 1], \"midpoint\": 0.5, \"sharpness\": 0}]}}")
                   .find("rgbTransferFunction.points[0].color: expected [r, g, b]"),
               std::string::npos);
     EXPECT_NE(json_error("{" + op + ", " + col + ", \"lighting\": {\"ambient\": 0.1}}")
                   .find("lighting.diffuse: missing"),
               std::string::npos);
-    EXPECT_NE(error_of([] { parse_slicer_vp_json("{\"volumeProperties\": [{\"components\": []}]}", "x.vp.json"); })
-                  .find("components: expected exactly one component"),
+    EXPECT_NE(error_of([] {
+                  parse_slicer_vp_json("{\"volumeProperties\": [{\"components\": []}]}",
+                                       "x.vp.json");
+              }).find("components: expected exactly one component"),
               std::string::npos);
-    EXPECT_NE(error_of([] { parse_slicer_vp_json("{", "x.vp.json"); }).find("x.vp.json: json: not valid JSON"),
+    EXPECT_NE(error_of([] {
+                  parse_slicer_vp_json("{", "x.vp.json");
+              }).find("x.vp.json: json: not valid JSON"),
               std::string::npos);
 }
 
@@ -234,14 +252,17 @@ TEST(SlicerPresets, SpecsSelectEntriesAndListNames) {
                   .find("preset: unknown 'CT-Bonez'; expected one of: Lacuna-CT-Bone, "
                         "Lacuna-MR-Brain, Lacuna-Step"),
               std::string::npos);
-    EXPECT_NE(error_of([&] { resolve_slicer_preset("slicer:" + file); })
-                  .find("expected a preset name after '#'"),
+    EXPECT_NE(error_of([&] {
+                  resolve_slicer_preset("slicer:" + file);
+              }).find("expected a preset name after '#'"),
               std::string::npos);
-    EXPECT_NE(error_of([] { resolve_slicer_preset("slicer:/nonexistent/p.xml#a"); })
-                  .find("/nonexistent/p.xml: file: cannot open"),
+    EXPECT_NE(error_of([] {
+                  resolve_slicer_preset("slicer:/nonexistent/p.xml#a");
+              }).find("/nonexistent/p.xml: file: cannot open"),
               std::string::npos);
-    EXPECT_NE(error_of([] { resolve_slicer_preset("slicer:notes.txt#a"); })
-                  .find("expected a Slicer preset file ending in .xml, .vp or .vp.json"),
+    EXPECT_NE(error_of([] {
+                  resolve_slicer_preset("slicer:notes.txt#a");
+              }).find("expected a Slicer preset file ending in .xml, .vp or .vp.json"),
               std::string::npos);
 }
 

@@ -35,8 +35,11 @@ TEST(TransferJson, RoundTripsTheRenderingKeys) {
     tf.rendering.blend = BlendMode::MinIp;
     const std::string text = to_json(tf);
     EXPECT_EQ(parse_transfer_function(text, "t.json"), tf) << text;
-    EXPECT_NE(text.find(R"("shading": {"ambient": 0.1, "diffuse": 0.9, "specular": 0.2, "specular_power": 10})"),
-              std::string::npos) << text;
+    EXPECT_NE(
+        text.find(
+            R"("shading": {"ambient": 0.1, "diffuse": 0.9, "specular": 0.2, "specular_power": 10})"),
+        std::string::npos)
+        << text;
     EXPECT_NE(text.find(R"("blend": "minip")"), std::string::npos) << text;
     // Each part alone, and none: a TF without them writes none of the keys.
     for (int part = 0; part < 4; ++part) {
@@ -207,13 +210,17 @@ TEST(TransferJson, RejectsEveryMalformedDocumentWithOneLineError) {
         {doc(c + ", " + o + R"(, "shading": true)"), "shading"},
         {doc(c + ", " + o + R"(, "shading": {"ambient": 0.1, "diffuse": 1, "specular": 0})"),
          "shading.specular_power"},
-        {doc(c + ", " + o + R"(, "shading": {"ambient": "a", "diffuse": 1, "specular": 0, "specular_power": 1})"),
+        {doc(c + ", " + o +
+             R"(, "shading": {"ambient": "a", "diffuse": 1, "specular": 0, "specular_power": 1})"),
          "shading.ambient"},
-        {doc(c + ", " + o + R"(, "shading": {"ambient": 0, "diffuse": 1, "specular": 0, "specular_power": 1, "shine": 2})"),
+        {doc(c + ", " + o +
+             R"(, "shading": {"ambient": 0, "diffuse": 1, "specular": 0, "specular_power": 1, "shine": 2})"),
          "shading.shine"},
-        {doc(c + ", " + o + R"(, "shading": {"ambient": 1.5, "diffuse": 1, "specular": 0, "specular_power": 1})"),
+        {doc(c + ", " + o +
+             R"(, "shading": {"ambient": 1.5, "diffuse": 1, "specular": 0, "specular_power": 1})"),
          "shading"},
-        {doc(c + ", " + o + R"(, "shading": {"ambient": 0, "diffuse": 1, "specular": 0, "specular_power": -1})"),
+        {doc(c + ", " + o +
+             R"(, "shading": {"ambient": 0, "diffuse": 1, "specular": 0, "specular_power": -1})"),
          "shading"},
         {doc(c + ", " + o + R"(, "gradient_opacity": [])"), "gradient_opacity"},
         {doc(c + ", " + o + R"(, "gradient_opacity": {"x": 0})"), "gradient_opacity"},

@@ -37,8 +37,7 @@ void expect_linear(const Volume& in, const Volume& out, const Linear& f, double 
     for (int k = 0; k < d.z; ++k)
         for (int j = 0; j < d.y; ++j)
             for (int i = 0; i < d.x; ++i) {
-                const double want =
-                    f(pos(i, di.x, d.x), pos(j, di.y, d.y), pos(k, di.z, d.z));
+                const double want = f(pos(i, di.x, d.x), pos(j, di.y, d.y), pos(k, di.z, d.z));
                 ASSERT_NEAR(out.value(i, j, k), want, tol)
                     << "voxel " << i << "," << j << "," << k << " of " << to_string(out);
             }
@@ -61,9 +60,9 @@ TEST(Resample, IntegerTypesRoundTheLinearFieldToNearest) {
         VoxelType type;
         Linear f;
     };
-    for (const Case& c : {Case{VoxelType::UInt8, {10, 3, 5, 7}},
-                          Case{VoxelType::UInt16, {100, 300, -20, 700}},
-                          Case{VoxelType::Int16, {-1000, 37, 11, -40}}}) {
+    for (const Case& c :
+         {Case{VoxelType::UInt8, {10, 3, 5, 7}}, Case{VoxelType::UInt16, {100, 300, -20, 700}},
+          Case{VoxelType::Int16, {-1000, 37, 11, -40}}}) {
         const Volume in = linear_volume({8, 6, 7}, c.type, c.f);
         const Volume out = resample_trilinear(in, {13, 11, 3}, 0);
         EXPECT_EQ(out.type(), c.type);
