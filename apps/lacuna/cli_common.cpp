@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "lacuna/error.h"
+#include "lacuna/rgb.h"
 #include "lacuna/views.h"
 
 namespace lacuna::cli {
@@ -32,6 +33,10 @@ void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required) {
                    "4D NIfTI files: which volume along the 4th axis (0-based; required when the "
                    "file holds several)");
     cmd.add_option("--spacing", a.spacing, "Raw files: voxel spacing X,Y,Z in mm (default 1,1,1)");
+    cmd.add_option("--rgb-opacity", a.rgb_opacity,
+                   "RGB/RGBA files: the scalar the TF's opacity and skipping read: luminance "
+                   "(Rec. 709), r, g, b or a (colour always comes from the data)")
+        ->capture_default_str();
 }
 
 uint64_t parse_bytes(const std::string& s, const std::string& where) {
@@ -153,7 +158,7 @@ Volume load_volume(const VolumeArgs& a) {
     ro.allow_external_data = a.allow_external_data;
     Progress progress("loading " + std::filesystem::path(a.path).filename().string());
     ro.progress = [&](double f) { progress.update(f); };
-    Volume v = read_volume(a.path, ro);
+    Volume v = read_volume(a.path, ro, parse_rgb_opacity(a.rgb_opacity, "--rgb-opacity"));
     progress.done();
     if (a.range_value || !a.range.empty()) {
         const ValueRange r = a.range_value ? *a.range_value : parse_range(a.range);

@@ -23,6 +23,7 @@ struct VolumeArgs {
     bool allow_external_data = false;
     std::optional<int64_t> frame;  // --frame: the volume of a 4D NIfTI file
     std::string spacing;           // --spacing X,Y,Z for .raw files (mm)
+    std::string rgb_opacity = "luminance";  // --rgb-opacity: RGB files' opacity scalar
     // Typed values a session file gives (render --session), used instead of the strings above.
     std::optional<RawSpec> raw_spec;
     std::optional<ValueRange> range_value;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cli_common.h"
+#include "lacuna/rgb.h"
 #include "lacuna/orientation.h"
 
 namespace lacuna::cli {
@@ -19,6 +20,12 @@ void run(const VolumeArgs& args) {
     std::printf("dims:        %d x %d x %d (%zu voxels, %.1f MiB)\n", d.x, d.y, d.z, v.voxel_count(),
                 double(v.bytes()) / (1 << 20));
     std::printf("type:        %s\n", to_string(v.type()).c_str());
+    if (const RgbColours* rgb = rgb_colours(v))
+        std::printf("channels:    %s (colour from the data; opacity scalar: %s, %s)\n",
+                    rgb->channels == 4 ? "RGBA (RGBA32)" : "RGB (RGB24)",
+                    to_string(rgb->opacity).c_str(),
+                    rgb->opacity == RgbOpacity::Luminance ? "Rec. 709 float32"
+                                                            : "the channel, uint8");
     std::printf("spacing:     %g x %g x %g mm\n", v.spacing.x, v.spacing.y, v.spacing.z);
     // World frame (docs/formats.md): patient RAS mm; origin and direction also in ITK's LPS.
     const Affine a = index_to_world(v);

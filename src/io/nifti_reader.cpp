@@ -10,6 +10,7 @@
 //   sizeof_hdr   0   int32        0   int32
 //   magic        344 char[4]      4   char[8]
 //   datatype     70  int16        12  int16
+//   bitpix       72  int16        14  int16
 //   dim[8]       40  int16        16  int64
 //   pixdim[8]    76  float        104 double
 //   vox_offset   108 float        168 int64
@@ -35,6 +36,7 @@
 
 #include "io/io_util.h"
 #include "io/readers.h"
+#include "io/rgb_volume.h"
 #include "lacuna/error.h"
 #include "lacuna/orientation.h"
 
@@ -52,6 +54,7 @@ struct NiftiHeader {
     bool swap = false;
     int64_t dim[8] = {};
     int datatype = 0;
+    int bitpix = 0;
     double pixdim[8] = {};
     int64_t vox_offset = 0;
     double slope = 0, inter = 0;
@@ -145,6 +148,7 @@ NiftiHeader parse_header(gzFile f, const std::string& path, bool pair) {
                              : "not a NIfTI-1 file (magic 'n+1' missing; Analyze 7.5 is not supported)");
         for (int i = 0; i < 8; ++i) h.dim[i] = get<int16_t>(buf, 40 + 2 * i, s);
         h.datatype = get<int16_t>(buf, 70, s);
+        h.bitpix = get<int16_t>(buf, 72, s);
         for (int i = 0; i < 8; ++i) h.pixdim[i] = get<float>(buf, 76 + 4 * i, s);
         const double off = get<float>(buf, 108, s);
         if (!std::isfinite(off) || off < 0 || off > 1e15)
@@ -169,6 +173,7 @@ NiftiHeader parse_header(gzFile f, const std::string& path, bool pair) {
                         pair ? "not a NIfTI-2 pair header (magic 'ni2' missing)"
                              : "not a NIfTI-2 file (magic 'n+2' missing)");
         h.datatype = get<int16_t>(buf, 12, s);
+        h.bitpix = get<int16_t>(buf, 14, s);
         for (int i = 0; i < 8; ++i) h.dim[i] = get<int64_t>(buf, 16 + 8 * i, s);
         for (int i = 0; i < 8; ++i) h.pixdim[i] = get<double>(buf, 104 + 8 * i, s);
         h.vox_offset = get<int64_t>(buf, 168, s);
@@ -212,9 +217,8 @@ DiskType disk_type_from(int datatype, const std::string& path) {
         case 1280:
             return DiskType::U64;
         case 128:
-            throw Error(path, "datatype", "expected a scalar image, got 3 components (RGB24)");
         case 2304:
-            throw Error(path, "datatype", "expected a scalar image, got 4 components (RGBA32)");
+            return DiskType::U8;  // RGB24 / RGBA32: bytes, read by read_rgb_stream
         case 32:
         case 1792:
         case 2048:
@@ -227,6 +231,21 @@ DiskType disk_type_from(int datatype, const std::string& path) {
             throw Error(path, "datatype",
                         "unknown NIfTI datatype code " + std::to_string(datatype));
     }
+}
+
+// Colour channels of an RGB24 (3) or RGBA32 (4) file, 0 for a scalar one. Their bitpix must
+// agree (24, 32): a file that says otherwise has been written wrong and its voxel size is
+// unknowable. nifti1.h stores the channels interleaved per voxel (r, g, b[, a]) and says
+// scl_slope/scl_inter do not apply to them.
+int rgb_channels(const NiftiHeader& h, const std::string& path) {
+    if (h.datatype != 128 && h.datatype != 2304) return 0;
+    const int channels = h.datatype == 128 ? 3 : 4;
+    if (h.bitpix != 8 * channels)
+        throw Error(path, "bitpix",
+                    "expected " + std::to_string(8 * channels) + " for " +
+                        (channels == 3 ? "RGB24" : "RGBA32") + " (datatype " +
+                        std::to_string(h.datatype) + "), got " + std::to_string(h.bitpix));
+    return channels;
 }
 
 // The grid of one volume, and how many volumes the file holds along dim[4] (time, or any 4th
@@ -505,7 +524,7 @@ NiftiFiles nifti_files(const std::string& path) {
 
 }  // namespace
 
-Volume read_nifti(const std::string& path, const ReadOptions& opts) {
+Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity rgb_opacity) {
     const NiftiFiles files = nifti_files(path);
     GzFile hf(gzopen(files.header.c_str(), "rb"));
     if (!hf) throw Error(files.header, "file", std::string("cannot open: ") + std::strerror(errno));
@@ -522,17 +541,23 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
     const Vec3i dims = grid.dims;
     const int64_t frame = chosen_frame(grid.frames, opts.frame, path);
     const DiskType disk = disk_type_from(h.datatype, path);
+    const int channels = rgb_channels(h, path);  // 0: a scalar file
+    if (channels) check_rgb_opacity(channels, rgb_opacity, path);
 
     // NIfTI: slope 0 (or non-finite) means "no scaling"; scaled data is float, as in ITK.
-    const bool rescale = std::isfinite(h.slope) && std::isfinite(h.inter) && h.slope != 0.0 &&
-                         (h.slope != 1.0 || h.inter != 0.0);
-    const VoxelType type = rescale ? VoxelType::Float32 : stored_type(disk);
+    const bool rescale = !channels && std::isfinite(h.slope) && std::isfinite(h.inter) &&
+                         h.slope != 0.0 && (h.slope != 1.0 || h.inter != 0.0);
+    const VoxelType type = channels ? rgb_scalar_type(rgb_opacity)
+                                    : rescale ? VoxelType::Float32 : stored_type(disk);
     // dims are 2..kMaxDim each, so these products fit; sat_add guards a wild vox_offset. The
     // chosen volume starts `frame` volumes after vox_offset (frames are stored one after another).
-    const uint64_t data_bytes = grid_bytes(dims, disk_type_size(disk));
+    const uint64_t data_bytes = grid_bytes(dims, channels ? channels : disk_type_size(disk));
     const uint64_t offset = sat_add(uint64_t(h.vox_offset), sat_mul(uint64_t(frame), data_bytes));
-    check_budget(path, "dims", dims_string(dims) + " " + to_string(type),
-                 grid_bytes(dims, voxel_size(type)), opts.max_memory);
+    check_budget(path, "dims",
+                 dims_string(dims) + " " + (channels ? std::string(channels == 3 ? "RGB24" : "RGBA32")
+                                                     : to_string(type)),
+                 grid_bytes(dims, channels ? rgb_bytes_per_voxel(rgb_opacity) : voxel_size(type)),
+                 opts.max_memory);
 
     // An uncompressed file's length is known: report truncation before allocating. A
     // compressed one is inflated incrementally into the buffer, whose pages are only touched
@@ -549,7 +574,7 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
                             std::to_string(file_bytes > offset ? file_bytes - offset : 0));
     }
 
-    Volume v(dims, type, path);
+    Volume v = channels ? rgb_volume(dims, channels, rgb_opacity, path) : Volume(dims, type, path);
     set_geometry(h, v, path);
     check_geometry(v, path);  // before the voxels are read
     // (a compressed file is inflated up to the offset; gzseek says -1 if the stream ends first)
@@ -559,9 +584,20 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts) {
                     frame ? "truncated: the file ends before volume " + std::to_string(frame) +
                                 " at offset " + std::to_string(offset)
                           : "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
-    read_voxel_stream([&](void* buf, size_t n) { return gz_read_all(f, buf, n, data_path); }, disk,
-                      h.swap, v, data_path, opts.progress, rescale, h.slope, h.inter);
+    const auto read = [&](void* buf, size_t n) { return gz_read_all(f, buf, n, data_path); };
+    if (channels)  // bytes: no byte order to swap
+        read_rgb_stream(read, v, data_path, opts.progress);
+    else
+        read_voxel_stream(read, disk, h.swap, v, data_path, opts.progress, rescale, h.slope,
+                          h.inter);
     return v;
+}
+
+int64_t nifti_frames(const std::string& path) {
+    const NiftiFiles files = nifti_files(path);
+    GzFile hf(gzopen(files.header.c_str(), "rb"));
+    if (!hf) throw Error(files.header, "file", std::string("cannot open: ") + std::strerror(errno));
+    return checked_dims(parse_header(hf.get(), files.header, files.pair), path).frames;
 }
 
 }  // namespace lacuna::io

@@ -5,13 +5,18 @@
 #include <string>
 
 #include "lacuna/io.h"
+#include "lacuna/rgb.h"
 #include "lacuna/volume.h"
 
 namespace lacuna::io {
 
 // .nii / .nii.gz, NIfTI-1 and NIfTI-2, parsed by our own code (nifti_reader.cpp) so the voxels
 // are inflated straight into the volume's buffer.
-Volume read_nifti(const std::string& path, const ReadOptions& opts);
+// RGB24/RGBA32 files: their opacity scalar is `rgb_opacity` (lacuna/rgb.h).
+Volume read_nifti(const std::string& path, const ReadOptions& opts,
+                  RgbOpacity rgb_opacity = RgbOpacity::Luminance);
+// The volumes of a NIfTI file along dim[4] (1 for a 3D file), from its header alone.
+int64_t nifti_frames(const std::string& path);
 // NRRD (.nrrd/.nhdr), MetaImage (.mha/.mhd) and anything else ITK recognises.
 Volume read_itk(const std::string& path, const ReadOptions& opts);
 // A folder holding a DICOM series.

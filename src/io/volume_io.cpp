@@ -8,10 +8,16 @@
 #include "lacuna/error.h"
 #include "lacuna/io.h"
 #include "lacuna/orientation.h"
+#include "lacuna/rgb.h"
+#include "lacuna/volume_frames.h"
 
 namespace lacuna {
 
 Volume read_volume(const std::string& path, const ReadOptions& opts) {
+    return read_volume(path, opts, RgbOpacity::Luminance);
+}
+
+Volume read_volume(const std::string& path, const ReadOptions& opts, RgbOpacity rgb_opacity) {
     io::report(opts.progress, 0.0);
     Volume v;
     try {
@@ -28,7 +34,7 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
             io::check_readable_file(path);
             const std::string ext = io::format_extension(path);
             if (nifti)  // .nii, .nii.gz and the two-file pairs .hdr + .img (or .img.gz)
-                v = io::read_nifti(path, opts);
+                v = io::read_nifti(path, opts, rgb_opacity);
             else if (ext == ".raw")
                 v = io::read_raw(path, opts);
             else
@@ -46,6 +52,19 @@ Volume read_volume(const std::string& path, const ReadOptions& opts) {
     }
     io::report(opts.progress, 1.0);
     return v;
+}
+
+int64_t count_volume_frames(const std::string& path) {
+    const std::string e = io::format_extension(path);
+    if (e != ".nii" && e != ".nii.gz" && e != ".hdr" && e != ".img" && e != ".img.gz") return 1;
+    try {
+        io::check_readable_file(path);
+        return io::nifti_frames(path);
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(path, "read", io::one_line(e.what()));
+    }
 }
 
 void write_volume(const std::string& path, const Volume& v) {

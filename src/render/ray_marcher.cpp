@@ -16,6 +16,7 @@
 #include "render/lane_scheduler.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
+#include "render/rgb_march.h"
 #include "render/volume_frame.h"
 
 namespace lacuna {
@@ -147,6 +148,10 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                     const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
                     ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
                     std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+    if (rgb_colours(vol)) {  // colour from the data: the one-ray kernel of render/rgb_march.h only
+        render_rgb_tile<T, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays);
+        return;
+    }
     if (!small || (x1 - x0) * (y1 - y0) > kMaxTilePixels) {
         render_tile<T, int64_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                 samples, rays);
@@ -316,6 +321,7 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
             throw FrameError("features", "a brick renders without features or early termination");
         check_brick(m_volume, *opt.brick);
     }
+    check_rgb_options(m_volume, opt);
     if (opt.features.any()) return render_features(cam, opt);
     RenderResult out;
     out.image = Image(cam.width(), cam.height());

@@ -8,6 +8,7 @@
 #include "core/check.h"
 #include "lacuna/error.h"
 #include "lacuna/orientation.h"
+#include "lacuna/rgb.h"
 #include "session/structure_registry.h"
 #include "slice/box_sources.h"
 #include "slice/slice_renderer.h"
@@ -312,6 +313,8 @@ FrameResult Session::prepare(const FrameSpec& spec) {
             throw FrameError("features", "distributed rendering takes no features yet "
                                          "(shading, clipping, crop, blend, jitter, two TFs)");
     }
+    if (rgb_colours(*m_volume) && spec.renderer != Renderer::RayMarcher)  // src/render/rgb_march.h
+        throw FrameError("renderer", "an RGB volume renders with the ray marcher only");
     FrameResult out;
     switch (spec.renderer) {
         case Renderer::RayMarcher: prepare_marcher(spec, out); break;
