@@ -54,6 +54,7 @@
     wlPreset: 'vis',
     interpolation: 'trilinear',
     overlayOpacity: 0.4,
+    volumeFrame: 0,  // the volume of a 4D file the server shows (hello.frame)
   };
   let hello = null;
   let ws = null;
@@ -93,6 +94,7 @@
     if (msg.type === 'probe') return onProbe(msg);
     if (msg.type === 'session' || msg.type === 'tf_export' || msg.type === 'tf_import') return onFile(msg);
     if (msg.type === 'session_import') return onSessionOpened(msg);
+    if (msg.type === 'volume_frame') return onVolumeFrame(msg);
     if (msg.type === 'error') {
       // The server rejected a request: show it (not a console error: the page stays usable).
       setStatus('server: ' + msg.message);
@@ -103,12 +105,14 @@
         if (msg.id !== null && msg.id === pane.inFlight) { pane.inFlight = null; flushSlice(pane); }
       }
       if (msg.id !== null && msg.id === probeInFlight) { probeInFlight = null; flushProbe(); }
+      if (msg.id !== null && msg.id === framePending.id) { framePending = { id: null, frame: null }; showFrameSelector(); }
     }
   }
 
   function onHello(msg) {
     hello = msg;
-    $('title').textContent = `lacuna · ${msg.volume.name} (${msg.volume.dims.join('×')} ${msg.volume.type})`;
+    showTitle();
+    showFrameSelector();
     fillSelect($('renderer'), msg.renderers, state.renderer);
     state.renderer = $('renderer').value;
     fillSelect($('accel'), msg.accels, msg.accels.includes('grid') ? 'grid' : msg.accels[0]);
@@ -130,6 +134,51 @@
     setStatus('');
     request(false);
     startSlices(msg);
+  }
+
+  function showTitle() {
+    const v = hello.volume;
+    $('title').textContent = `lacuna · ${v.name} (${v.dims.join('×')} ${v.type})`;
+  }
+
+  // ---- the frame selector of a 4D file (hello.frames > 1) -------------------------------------
+  // The server reads the chosen volume and answers every tab with its info; the 3D view, the
+  // slices, the probe and the TF editor's histogram then follow (session files name the frame).
+  function showFrameSelector() {
+    const n = hello.frames || 1;
+    state.volumeFrame = hello.frame || 0;
+    $('frame-row').hidden = !(n > 1 && (hello.messages || []).includes('volume_frame'));
+    for (const el of [$('volume-frame'), $('volume-frame-n')]) {
+      el.max = String(n - 1);
+      el.value = String(state.volumeFrame);
+    }
+    $('volume-frames').textContent = `of ${n}`;
+  }
+  function chooseFrame(value) {
+    const k = Math.round(Number(value));
+    if (!hello || !Number.isFinite(k) || k < 0 || k >= (hello.frames || 1)) return showFrameSelector();
+    $('volume-frame').value = $('volume-frame-n').value = String(k);
+    if (k === state.volumeFrame || k === framePending.frame || !ws || ws.readyState !== WebSocket.OPEN) return;
+    setStatus(`reading frame ${k}…`);
+    framePending = { id: nextId++, frame: k };
+    ws.send(JSON.stringify({ type: 'volume_frame', id: framePending.id, frame: k }));
+  }
+  let framePending = { id: null, frame: null };  // the volume_frame message awaiting its answer
+  $('volume-frame').addEventListener('change', (e) => chooseFrame(e.target.value));
+  $('volume-frame-n').addEventListener('change', (e) => chooseFrame(e.target.value));
+  function onVolumeFrame(msg) {
+    framePending = { id: null, frame: null };
+    hello.volume = msg.volume;
+    hello.histogram = msg.histogram;
+    hello.frame = msg.frame;
+    hello.frames = msg.frames;
+    showTitle();
+    showFrameSelector();
+    drawTf();
+    setStatus('');
+    request(false);
+    requestSlices();
+    requestProbe();
   }
 
   // Binary messages: a frame of the 3D view or a slice of a pane, by the header's type.
@@ -830,7 +879,8 @@
   // What a pane's picture depends on; a pane is fetched again only when this changes.
   function sliceKey(pane) {
     return JSON.stringify([dot(state.point, kNormals[pane.plane]), state.window, state.level,
-                           state.interpolation, hasLabels() ? state.overlayOpacity : 0]);
+                           state.interpolation, hasLabels() ? state.overlayOpacity : 0,
+                           state.volumeFrame]);
   }
   function requestSlices() {
     for (const pane of Object.values(panes)) {

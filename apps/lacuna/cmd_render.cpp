@@ -178,6 +178,13 @@ Setup from_session(RenderArgs& a) {
     a.elevation = f.frame.camera.orbit.elevation_deg;
     a.ortho = f.frame.camera.orbit.projection == Projection::Orthographic;
     a.slice.renderer = f.frame.renderer == Renderer::Slicer ? "slice" : "march";
+    // The segment renderer: its label volume (mask mode), mode and table from the file.
+    a.segments = SegmentArgs{};
+    if (f.frame.renderer == Renderer::Segments) {
+        a.segments.mode = f.frame.segments.mode == SegmentMode::Labels ? "labels" : "mask";
+        a.segments.labels = f.labels.value_or("");
+        a.segments.tint = f.frame.segments.tint;
+    }
     check_outputs(a);
     Setup s;
     s.spec = f.frame;
@@ -189,8 +196,8 @@ std::string session_text(const RenderArgs& a, const Setup& s) {
     namespace fs = std::filesystem;
     if (s.spec.renderer == Renderer::Segments)
         throw Error("--save-session", "frame.renderer",
-                    "a session of the segment renderer is not supported yet (it would need the "
-                    "label map)");
+                    "not yet for the segment renderer (its label table is made while "
+                    "rendering); the viewer's session button saves one");
     SessionFile f;
     f.volume.path = fs::absolute(a.volume.path).lexically_normal().string();
     f.volume.frame = a.volume.frame;
@@ -466,7 +473,7 @@ void render_frames(RenderArgs& a, const Setup& s) {
         case Renderer::Segments: {
             Progress summary("render", 1, "frame");
             render_segments(a.segments, SegmentFrame{a.volume, a.tf, accel, a.threads, s.spec,
-                                                     a.out, a.heatmap});
+                                                     a.out, a.heatmap, a.tf_value});
             std::fflush(stdout);
             summary.done();
             return;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "cli_common.h"
+#include "lacuna/volume_frames.h"
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
 #include "serve/frame_renderer.h"
@@ -30,7 +31,19 @@ void run(const ServeArgs& a) {
     so.port = uint16_t(a.port);
     so.handle_signals = true;
     so.log = true;
-    Volume vol = load_volume(a.volume);
+    // A 4D file: the page's frame selector picks among its volumes (volume 0 unless --frame).
+    VolumeArgs first = a.volume;
+    if (const int64_t frames = count_volume_frames(a.volume.path); frames > 1) {
+        if (!first.frame) first.frame = 0;
+        so.frames = frames;
+        so.frame = *first.frame;
+        so.load_frame = [args = a.volume](int64_t k) {
+            VolumeArgs b = args;
+            b.frame = k;
+            return load_volume(b);
+        };
+    }
+    Volume vol = load_volume(first);
     // CT (int16, Hounsfield units) starts with bone, everything else with the MRI default.
     so.initial_tf = resolve_transfer_function(
         !a.tf.empty() ? a.tf : (vol.type() == VoxelType::Int16 ? "ct-bone" : "mr-default"));
@@ -38,7 +51,7 @@ void run(const ServeArgs& a) {
     // What the page's session files name (read as `lacuna render --save-session` writes it).
     SessionVolume sv;
     sv.path = std::filesystem::absolute(a.volume.path).lexically_normal().string();
-    sv.frame = a.volume.frame;
+    sv.frame = first.frame;
     sv.raw = raw_spec_of(a.volume);
     if (!a.volume.range.empty()) sv.range = parse_range(a.volume.range);
     so.session_volume = sv;
@@ -50,6 +63,7 @@ void run(const ServeArgs& a) {
         VolumeArgs la;
         la.path = a.labels;
         renderer.set_labels(load_volume(la));
+        so.labels_path = std::filesystem::absolute(a.labels).lexically_normal().string();
     }
     serve::Server server(renderer, so);
     server.start();

@@ -34,9 +34,10 @@ void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
     const bool octree = std::holds_alternative<structure::LabelOctree>(spec.structure);
     if (masked && a.labels.empty())
         throw Error("--segments", "mode", "mask mode needs --labels FILE");
-    if (masked && f.tf.empty()) throw Error("render", "--tf", "mask mode needs a transfer function");
+    if (masked && f.tf.empty() && !f.tf_value)
+        throw Error("render", "--tf", "mask mode needs a transfer function");
     std::optional<TransferFunction> tf;
-    if (masked) tf = resolve_transfer_function(f.tf);
+    if (masked) tf = f.tf_value ? *f.tf_value : resolve_transfer_function(f.tf);
     // Labels mode reads the label volume alone: --labels, or else the VOLUME argument.
     VolumeArgs la;
     la.path = a.labels;
@@ -45,8 +46,10 @@ void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
         session.set_labels(load_volume(la));
         session.set_transfer_function(*tf);
     }
-    LabelTable table = a.style.empty() ? session.label_table()
-                                       : load_label_table(a.style, session.label_volume());
+    // A session file's frame carries its table; otherwise the default or --label-style's.
+    LabelTable table = spec.segments.labels ? *spec.segments.labels
+                       : a.style.empty()    ? session.label_table()
+                                            : load_label_table(a.style, session.label_volume());
     for (const std::string& s : a.show) set_label_visibility(table, s, true, "--show");
     for (const std::string& s : a.hide) set_label_visibility(table, s, false, "--hide");
     spec.segments.labels = table;

@@ -3,10 +3,12 @@
 #pragma once
 #include <CLI/CLI.hpp>
 
+#include <optional>
 #include <string>
 
 #include "cli_common.h"
 #include "lacuna/frame_spec.h"
+#include "lacuna/transfer_function.h"
 
 namespace lacuna::cli {
 
@@ -29,6 +31,7 @@ struct SegmentFrame {
     int threads = 0;
     FrameSpec spec;
     std::string out, heatmap;
+    std::optional<TransferFunction> tf_value;  // the TF itself (a session file's), else `tf` resolved
 };
 void render_segments(const SegmentArgs& a, const SegmentFrame& f);
 

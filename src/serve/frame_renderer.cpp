@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
 
 #include "core/parallel.h"
 #include "lacuna/error.h"
@@ -52,6 +53,21 @@ FrameRenderer::FrameRenderer(Volume volume, const AccelOptions& accel_options, i
 }
 
 FrameRenderer::~FrameRenderer() = default;
+
+void FrameRenderer::set_volume(Volume volume) {
+    std::optional<Volume> labels;
+    if (m_session->has_labels()) {
+        labels = m_session->label_volume();  // shares the voxels
+        check_label_volume(*labels, &volume, "labels");
+    }
+    auto session = std::make_unique<Session>(std::move(volume), m_threads);
+    if (labels) {
+        session->set_labels(std::move(*labels));
+        (void)session->label_table();
+    }
+    m_histogram = compute_histogram(session->volume(), kHistogramBins, m_threads);
+    m_session = std::move(session);
+}
 
 void FrameRenderer::set_labels(Volume labels) {
     check_label_volume(labels, &m_session->volume(), "labels");

@@ -44,6 +44,11 @@ class FrameRenderer {
     // A label volume (same dims) for the page's segments toggle (docs/segments.md). Throws
     // lacuna::Error if it cannot be a label map of this volume.
     void set_labels(Volume labels);
+    // Replaces the volume (another volume of a 4D file: the viewer's frame selector): a fresh
+    // session (its structures rebuild lazily), the label volume kept, the histogram recomputed.
+    // Throws lacuna::Error, keeping the old volume, if the labels cannot label the new one. Not
+    // thread-safe against anything: the server calls it with the render thread locked out.
+    void set_volume(Volume volume);
     int label_count() const { return m_session->has_labels() ? m_session->label_table().size() : 0; }
     // Voxel counts in kHistogramBins equal bins over the visualization range.
     static constexpr int kHistogramBins = 256;

@@ -1,6 +1,8 @@
 #include "serve/protocol.h"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
@@ -154,7 +156,8 @@ constexpr std::pair<MessageKind, const char*> kMessageNames[] = {
     {MessageKind::Render, "render"},         {MessageKind::Slice, "slice"},
     {MessageKind::Probe, "probe"},           {MessageKind::Screenshot, "screenshot"},
     {MessageKind::Session, "session"},       {MessageKind::TfExport, "tf_export"},
-    {MessageKind::TfImport, "tf_import"},    {MessageKind::SessionImport, "session_import"}};
+    {MessageKind::TfImport, "tf_import"},    {MessageKind::SessionImport, "session_import"},
+    {MessageKind::VolumeFrame, "volume_frame"}};
 
 const char* message_name(MessageKind k) {
     for (const auto& [kind, name] : kMessageNames)
@@ -476,6 +479,16 @@ TfImportRequest parse_session_import_request(std::string_view text, const Limits
     return parse_file_request(text, limits, "session_import");
 }
 
+VolumeFrameRequest parse_volume_frame_request(std::string_view text, const Limits& limits) {
+    const json j = parse_json(text, limits);
+    if (text_of(j, "type", "") != "volume_frame") reject("type", "expected volume_frame");
+    only_keys(j, {"type", "id", "frame"}, "");
+    VolumeFrameRequest r;
+    r.id = id_of(j);
+    r.frame = integer(j, "frame", 0, std::numeric_limits<int>::max(), "");
+    return r;
+}
+
 std::string session_import_message(uint64_t id, const ViewRequest& v) {
     json camera{{"zoom", v.camera.zoom}, {"pan", {v.camera.pan_x, v.camera.pan_y}}};
     // A named view's angles go by name (superior and inferior are +-90, beyond free angles).
@@ -520,23 +533,41 @@ std::optional<uint64_t> request_id(std::string_view text, const Limits& limits) 
     }
 }
 
+namespace {
+
+// The hello's "volume" object.
+json volume_json(const HelloInfo& h) {
+    const Volume& v = *h.volume;
+    json out = {{"name", h.volume_name},
+                {"dims", {v.dims().x, v.dims().y, v.dims().z}},
+                {"type", to_string(v.type())},
+                {"spacing", {v.spacing.x, v.spacing.y, v.spacing.z}},
+                {"data_range", {v.data_range().min, v.data_range().max}},
+                {"vis_range", {v.vis_range().min, v.vis_range().max}}};
+    // Where the volume is in the world (patient RAS mm): the slice panes start their crosshair at
+    // the centre of this box (lacuna/orientation.h world_bounds, the sampled box [0, dims-1]).
+    const Box3f b = world_bounds(v);
+    out["world_bounds"] = {{"lo", {b.lo.x, b.lo.y, b.lo.z}}, {"hi", {b.hi.x, b.hi.y, b.hi.z}}};
+    out["orientation"] = orientation_code(v);
+    return out;
+}
+
+}  // namespace
+
+std::string volume_frame_message(uint64_t id, const HelloInfo& h) {
+    const json j{{"type", "volume_frame"}, {"id", id},         {"frame", h.frame},
+                 {"frames", h.frames},     {"volume", volume_json(h)}, {"histogram", h.histogram}};
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 std::string hello_message(const HelloInfo& h) {
     json j;
     j["type"] = "hello";
     j["version"] = kProtocolVersion;
-    const Volume& v = *h.volume;
-    j["volume"] = {{"name", h.volume_name},
-                   {"dims", {v.dims().x, v.dims().y, v.dims().z}},
-                   {"type", to_string(v.type())},
-                   {"spacing", {v.spacing.x, v.spacing.y, v.spacing.z}},
-                   {"data_range", {v.data_range().min, v.data_range().max}},
-                   {"vis_range", {v.vis_range().min, v.vis_range().max}}};
-    // Where the volume is in the world (patient RAS mm): the slice panes start their crosshair at
-    // the centre of this box (lacuna/orientation.h world_bounds, the sampled box [0, dims-1]).
-    const Box3f b = world_bounds(v);
-    j["volume"]["world_bounds"] = {{"lo", {b.lo.x, b.lo.y, b.lo.z}}, {"hi", {b.hi.x, b.hi.y, b.hi.z}}};
-    j["volume"]["orientation"] = orientation_code(v);
+    j["volume"] = volume_json(h);
     j["histogram"] = h.histogram;
+    j["frames"] = h.frames;
+    j["frame"] = h.frame;
     json presets = json::object();
     for (const auto& name : preset_names()) presets[name] = json::parse(to_json(preset(name)));
     j["presets"] = presets;

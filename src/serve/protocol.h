@@ -29,6 +29,9 @@
 //    (lacuna TF JSON or Slicer .vp.json, serve/tf_files.h).
 //   {"type":"tf_import", "id":N, "name":"file name", "text":"..."}: an uploaded TF file (lacuna
 //    JSON, Slicer .vp.json or .vp), answered with the TF as lacuna TF JSON.
+//   {"type":"volume_frame", "id":N, "frame":K}: show volume K (0-based) of the server's 4D NIfTI
+//    file (hello's "frames" > 1): the server reads it, renders every later request from it and
+//    answers every tab with the new volume's info; the session files it writes name the frame.
 //   {"type":"session_import", "id":N, "name":"...", "text":"..."}: a session file to open: answered
 //    with the view state that renders its frame exactly, or an error naming the first field the
 //    viewer cannot reproduce (another volume, a feature the page has no control for).
@@ -39,7 +42,8 @@
 //                                    renderers, capabilities, limits, "messages" (the
 //                                    types the server answers: render, slice, probe,
 //                                    screenshot, session, tf_export, tf_import,
-//                                    session_import), "session"
+//                                    session_import, volume_frame), "frames" and
+//                                    "frame" (the 4D file's volumes, the one shown), "session"
 //                                    (true when the server can write session files) and
 //                                    "slice_views" {"planes", "interpolations"}
 //          "capabilities": {"march": {"accels": [...], "features": [...]}, "slice": {...},
@@ -60,6 +64,7 @@
 //   text   {"type":"tf_export", "id", "format", "text":"...the file..."}
 //   text   {"type":"tf_import", "id", "tf":{...lacuna TF JSON...}}
 //   text   {"type":"session_import", "id", "view":{"width", "height", "camera", "renderer", ...}}
+//   text   {"type":"volume_frame", "id", "frame", "frames", "volume":{...}, "histogram":[...]}
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -135,7 +140,9 @@ struct ProbeRequest {
 };
 
 // The kinds of message the page sends, by "type".
-enum class MessageKind { Render, Slice, Probe, Screenshot, Session, TfExport, TfImport, SessionImport };
+enum class MessageKind {
+    Render, Slice, Probe, Screenshot, Session, TfExport, TfImport, SessionImport, VolumeFrame
+};
 // The message's "type" (throws lacuna::Error("message", "type"/"json"/..., ...) like
 // parse_request for a type not in message_names()).
 MessageKind message_kind(std::string_view text, const Limits& limits = {});
@@ -177,6 +184,14 @@ TfImportRequest parse_tf_import_request(std::string_view text, const Limits& lim
 // fields of tf_import).
 TfImportRequest parse_session_import_request(std::string_view text, const Limits& limits = {});
 
+// "volume_frame": {"type", "id", "frame": K}, the volume K of the server's 4D file to show
+// (the range is the server's to check: the parser only bounds it to 0..2^31-1).
+struct VolumeFrameRequest {
+    uint64_t id = 0;
+    int64_t frame = 0;
+};
+VolumeFrameRequest parse_volume_frame_request(std::string_view text, const Limits& limits = {});
+
 // Best effort: the "id" of a rejected message, to echo in the error (nullopt if none).
 std::optional<uint64_t> request_id(std::string_view text, const Limits& limits = {});
 
@@ -188,9 +203,13 @@ struct HelloInfo {
     std::vector<std::string> accels, renderers;
     int labels = 0;  // label values of the server's label volume (0: none loaded)
     bool session = false;  // the server knows its volume's file (session messages can be answered)
+    int64_t frames = 1, frame = 0;  // volumes in the server's file (4D NIfTI), the one shown
     Limits limits;
 };
 std::string hello_message(const HelloInfo& h);
+// The answer to volume_frame, sent to every tab (they all show the server's one volume):
+// {"type":"volume_frame", "id", "frame", "frames", "volume":{...as in hello}, "histogram"}.
+std::string volume_frame_message(uint64_t id, const HelloInfo& h);
 
 // What the page shows in its overlay, sent with every frame.
 struct FrameInfo {

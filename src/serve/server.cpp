@@ -149,6 +149,13 @@ struct Server::Impl {
     std::map<std::string, double> ms_per_unit;
 
     std::once_flag stop_once;
+    // Held by the render thread while it uses the renderer, and by the network thread while it
+    // swaps the renderer's volume (switch_frame); slices read the renderer on the network thread,
+    // the swap's own thread, so they need no lock.
+    std::mutex renderer_mutex;
+
+    HelloInfo hello_info() const;
+    void switch_frame(const std::string& text);
 
     void accept();
     void on_accept(beast::error_code ec, tcp::socket socket);
@@ -242,6 +249,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
                     answer_slice_or_probe(kind, text);
                 } else if (kind == MessageKind::Screenshot) {
                     queue_screenshot(text);
+                } else if (kind == MessageKind::VolumeFrame) {
+                    m_server->switch_frame(text);
                 } else if (kind != MessageKind::Render) {
                     answer_file_message(kind, text);
                 } else {
@@ -335,14 +344,17 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             if (!volume)
                 throw Error("session", "volume",
                             "this server's volume has no file to name (it was made in memory)");
-            if (req.segments && renderer.label_count() > 0)
-                throw Error("session", "segments",
-                            "a session file does not hold the label map yet; switch segments off "
-                            "to save the session");
             SessionFile f;
             f.volume = *volume;
             f.tf = req.tf;
             f.frame = renderer.frame_spec(req, req.width, req.height);
+            if (f.frame.renderer == Renderer::Segments) {
+                if (!m_server->options.labels_path)
+                    throw Error("session", "segments",
+                                "the server's label volume has no file to name (it was made in "
+                                "memory); switch segments off to save the session");
+                f.labels = m_server->options.labels_path;
+            }
             send_text(session_message(req.id, to_json(f, "session")));
             return;
         }
@@ -380,7 +392,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             throw Error(where, "volume.path",
                         "'" + f.volume.path + "' is not this server's volume" +
                             (volume ? " (" + volume->path + ")" : ""));
-        json mine = json::parse(to_json(SessionFile{*volume, f.tf, std::nullopt, f.frame}, where));
+        json mine = json::parse(to_json(SessionFile{*volume, f.tf, std::nullopt, f.frame, f.labels}, where));
         json theirs = json::parse(to_json(f, where));
         mine["volume"].erase("path");
         theirs["volume"].erase("path");
@@ -391,7 +403,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         // Exact: the view's frame is the session's, field by field.
         const json want = theirs["frame"];
         const json got = json::parse(to_json(
-            SessionFile{*volume, f.tf, std::nullopt, renderer.frame_spec(view, view.width, view.height)},
+            SessionFile{*volume, f.tf, std::nullopt, renderer.frame_spec(view, view.width, view.height), f.labels},
             where))["frame"];
         if (const std::string d = first_difference(want, got, "frame"); !d.empty())
             throw Error(where, d, "the viewer has no control for this value (its frame would differ)");
@@ -668,6 +680,7 @@ void Server::Impl::render_loop() {
             bool binary = false;
             try {
                 const CancelScope cancellable(cancel_frame);
+                const std::lock_guard<std::mutex> use(renderer_mutex);
                 reply = render_screenshot(*shot);
                 binary = true;
             } catch (const Cancelled&) {
@@ -712,10 +725,12 @@ void Server::Impl::render_loop() {
                 }
             }
             const Clock::time_point start = Clock::now();
+            std::unique_lock<std::mutex> use(renderer_mutex);
             Frame f = [&] {
                 const CancelScope cancellable(cancel_frame);  // the frame only, not refine()
                 return renderer.render(req, w, h);
             }();
+            use.unlock();
             ms_per_unit[key] = f.stats.seconds * 1e3 * double(req.step) / (double(w) * double(h));
             if (!req.preview) last_full_ms = f.stats.seconds * 1e3;
             FrameInfo info;
@@ -751,7 +766,10 @@ void Server::Impl::render_loop() {
                 std::lock_guard<std::mutex> lock(slot_mutex);
                 idle = ready.empty();
             }
-            if (idle && !req.preview) renderer.refine();
+            if (idle && !req.preview) {
+                const std::lock_guard<std::mutex> refining(renderer_mutex);
+                renderer.refine();
+            }
         } catch (const Cancelled&) {
             // A newer request of this tab (it is queued again and rendered next) or its closing:
             // the frame is not sent.
@@ -794,19 +812,51 @@ void Server::Impl::close_all() {
     ioc.stop();
 }
 
-Server::Server(FrameRenderer& renderer, ServerOptions options)
-    : m(std::make_unique<Impl>(renderer, std::move(options))) {
+HelloInfo Server::Impl::hello_info() const {
     HelloInfo h;
-    h.volume_name = m->options.volume_name;
+    h.volume_name = options.volume_name;
     h.volume = &renderer.volume();
     h.histogram = renderer.histogram();
-    h.initial_tf = m->options.initial_tf;
+    h.initial_tf = options.initial_tf;
     h.accels = accel_names();
     h.renderers = renderer_names();
     h.labels = renderer.label_count();
-    h.session = m->options.session_volume.has_value();
-    h.limits = m->options.limits;
-    m->hello = hello_message(h);
+    h.session = options.session_volume.has_value();
+    h.frames = options.load_frame ? options.frames : 1;
+    h.frame = options.frame;
+    h.limits = options.limits;
+    return h;
+}
+
+// Network thread. The new volume is read first (a failure leaves everything as it was), then
+// the render thread is locked out for the swap; the frame it was rendering is cancelled so the
+// lock comes quickly (a structure's first build still runs to its end).
+void Server::Impl::switch_frame(const std::string& text) {
+    const VolumeFrameRequest req = parse_volume_frame_request(text, options.limits);
+    if (!options.load_frame || options.frames < 2)
+        throw Error("volume_frame", "frame", "the server's volume has one frame (not a 4D file)");
+    if (req.frame >= options.frames)
+        throw Error("volume_frame", "frame",
+                    "expected 0.." + std::to_string(options.frames - 1) + ", got " +
+                        std::to_string(req.frame));
+    if (req.frame != options.frame) {
+        Volume v = options.load_frame(req.frame);
+        cancel_frame = true;
+        {
+            const std::lock_guard<std::mutex> swap(renderer_mutex);
+            renderer.set_volume(std::move(v));
+        }
+        options.frame = req.frame;
+        if (options.session_volume) options.session_volume->frame = req.frame;
+        hello = hello_message(hello_info());  // what tabs that connect later are told
+    }
+    const std::string answer = volume_frame_message(req.id, hello_info());
+    for (const auto& s : sessions) s->send_text(answer);
+}
+
+Server::Server(FrameRenderer& renderer, ServerOptions options)
+    : m(std::make_unique<Impl>(renderer, std::move(options))) {
+    m->hello = hello_message(m->hello_info());
 }
 
 Server::~Server() {

@@ -23,6 +23,9 @@
 //     two tiles (core/cancel.h; a structure's first build runs to its end);
 //   - a malformed or unrenderable message is answered with an "error" message naming the field;
 //     the connection and the server stay up;
+//   - a frame switch (volume_frame) reads the new volume on the network thread (other tabs wait
+//     for that read), cancels the frame in progress and swaps the renderer's volume while the
+//     render thread is locked out (renderer_mutex), so slices and frames never see half a switch;
 //   - a screenshot is rendered at its full size (no preview, no budget: the user asked for it),
 //     one per tab at a time, before the tab's pending render; a newer render does not cancel it,
 //     closing the tab does.
@@ -34,6 +37,7 @@
 #pragma once
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -60,6 +64,14 @@ struct ServerOptions {
     // The volume's file and read options, for the page's "session" messages (the session file
     // `lacuna render --session` reads); nullopt (a volume made in memory): they are refused.
     std::optional<SessionVolume> session_volume;
+    // The label volume's file (`lacuna serve --labels`), named by session files of the segments
+    // toggle; nullopt with a label volume: such sessions are refused.
+    std::optional<std::string> labels_path;
+    // A 4D file's volumes (the page's frame selector, "volume_frame" messages): how many, the one
+    // the renderer starts with, and how to read volume K (called on the network thread; its
+    // lacuna::Error is the page's error message). frames 1 or no load_frame: no selector.
+    int64_t frames = 1, frame = 0;
+    std::function<Volume(int64_t)> load_frame;
     TransferFunction initial_tf = preset("mr-default");
     int jpeg_quality = 88;
     int preview_quality = 75;

@@ -23,6 +23,8 @@ using Names = std::initializer_list<std::pair<E, const char*>>;
 const Names<Renderer> kRenderers = {{Renderer::RayMarcher, "raymarcher"},
                                     {Renderer::Slicer, "slicer"},
                                     {Renderer::Segments, "segments"}};
+const Names<SegmentMode> kSegmentModes = {{SegmentMode::Masked, "masked"},
+                                           {SegmentMode::Labels, "labels"}};
 const Names<Interpolation> kInterpolations = {{Interpolation::Trilinear, "trilinear"},
                                               {Interpolation::Nearest, "nearest"}};
 const Names<ShadingModel> kShadings = {
@@ -125,9 +127,23 @@ json features_json(const FeatureOptions& f) {
     };
 }
 
+// The segment renderer's part of a frame (written for its frames only, so other sessions keep
+// their bytes): mode, tint, and the label table when the frame carries one (null: the session's
+// default table).
+json segments_json(const SegmentsSpec& s) {
+    json table(nullptr);
+    if (s.labels) {
+        table = json::array();
+        for (const LabelStyle& l : s.labels->styles)
+            table.push_back({{"name", l.name}, {"color", json::array({l.r, l.g, l.b})},
+                             {"opacity", l.opacity}, {"visible", l.visible}});
+    }
+    return {{"mode", name_of(kSegmentModes, s.mode)}, {"tint", s.tint}, {"table", table}};
+}
+
 json frame_json(const FrameSpec& f) {
     const OrbitParams& o = f.camera.orbit;
-    return {
+    json j = {
         {"renderer", name_of(kRenderers, f.renderer)},
         {"structure", structure_json(f.structure)},
         {"sampling", {{"step", f.sampling.step},
@@ -154,6 +170,8 @@ json frame_json(const FrameSpec& f) {
         {"background", vec(f.background)},
         {"count_samples", f.count_samples},
     };
+    if (f.renderer == Renderer::Segments) j["segments"] = segments_json(f.segments);
+    return j;
 }
 
 // ---- Reading: each value through one of these, which name the field on a mismatch ------------
@@ -404,14 +422,45 @@ FeatureOptions read_features(const Reader& r) {
     return f;
 }
 
+SegmentsSpec read_segments(const Reader& r) {
+    r.expect_object({"mode", "tint", "table"});
+    SegmentsSpec s;
+    r.get("mode", s.mode, kSegmentModes);
+    r.get("tint", s.tint);
+    if (r.has("table") && !r.is_null("table")) {
+        const Reader t = r.at("table");
+        if (!t.value().is_array() || t.value().size() > size_t(kMaxLabel) + 1)
+            r.fail(t.field(), "expected an array of at most " + std::to_string(kMaxLabel + 1) +
+                                  " label styles");
+        LabelTable table;
+        for (size_t i = 0; i < t.value().size(); ++i) {
+            const Reader e(t.value()[i], t.field() + "[" + std::to_string(i) + "]", r.where());
+            e.expect_object({"name", "color", "opacity", "visible"});
+            LabelStyle l;
+            if (e.has("name")) l.name = e.text("name");
+            Vec3f c{l.r, l.g, l.b};
+            e.get("color", c);
+            l.r = c.x, l.g = c.y, l.b = c.z;
+            e.get("opacity", l.opacity);
+            if (!(l.opacity >= 0.f)) e.fail(e.sub("opacity"), "expected a number >= 0");
+            e.get("visible", l.visible);
+            table.styles.push_back(std::move(l));
+        }
+        s.labels = std::move(table);
+    }
+    return s;
+}
+
 FrameSpec read_frame(const Reader& r) {
     r.expect_object({"renderer", "structure", "sampling", "features", "two_tfs", "slicer",
-                     "camera", "width", "height", "background", "count_samples"});
+                     "camera", "width", "height", "background", "count_samples", "segments"});
     FrameSpec f;
     r.get("renderer", f.renderer, kRenderers);
-    if (f.renderer == Renderer::Segments)
-        r.fail(r.sub("renderer"), "a session of the segment renderer is not supported yet "
-                                  "(the file holds no label map)");
+    if (r.has("segments")) {
+        if (f.renderer != Renderer::Segments)
+            r.fail(r.sub("segments"), "given, but the renderer is not segments");
+        f.segments = read_segments(r.at("segments"));
+    }
     if (r.has("structure")) f.structure = read_structure(r.at("structure"), f.renderer);
     if (r.has("sampling")) {
         const Reader s = r.at("sampling");
@@ -520,13 +569,20 @@ TransferFunction read_tf(const Reader& r) {
     return parse_transfer_function(r.value().dump(), r.where() + ": " + r.field());
 }
 
+// Labels belong to (and are needed by) exactly the segment renderer's mask mode.
+void check_labels(const SessionFile& s, const std::string& where) {
+    const bool needs = s.frame.renderer == Renderer::Segments && s.frame.segments.mode == SegmentMode::Masked;
+    if (needs && (!s.labels || s.labels->empty()))
+        throw Error(where, "labels", "missing (frame.renderer is segments in mask mode: the frame "
+                                     "needs the label volume's path)");
+    if (!needs && s.labels)
+        throw Error(where, "labels", "given, but only the segment renderer's mask mode reads one");
+}
+
 }  // namespace
 
 std::string to_json(const SessionFile& s, const std::string& where) {
-    if (s.frame.renderer == Renderer::Segments)
-        throw Error(where, "frame.renderer",
-                    "a session of the segment renderer is not supported yet (it would need the "
-                    "label map)");
+    check_labels(s, where);
     json vol = {{"path", s.volume.path}};
     if (s.volume.frame) vol["frame"] = *s.volume.frame;
     if (s.volume.range) vol["range"] = json::array({s.volume.range->min, s.volume.range->max});
@@ -542,6 +598,7 @@ std::string to_json(const SessionFile& s, const std::string& where) {
               {"tf", json::parse(to_json(s.tf))},
               {"frame", frame_json(s.frame)}};
     if (s.tf_back) j["tf_back"] = json::parse(to_json(*s.tf_back));
+    if (s.labels) j["labels"] = {{"path", *s.labels}};
     return j.dump(2) + "\n";
 }
 
@@ -553,7 +610,7 @@ SessionFile parse_session_file(const std::string& text, const std::string& where
         throw Error(where, "json", std::string("not valid JSON: ") + e.what());
     }
     const Reader r(j, "", where);
-    r.expect_object({"lacuna_session", "volume", "tf", "tf_back", "frame"});
+    r.expect_object({"lacuna_session", "volume", "labels", "tf", "tf_back", "frame"});
     {
         const json& v = r.at("lacuna_session").value();
         if (!v.is_number_integer() || v.get<int64_t>() != kSessionFileVersion)
@@ -565,6 +622,13 @@ SessionFile parse_session_file(const std::string& text, const std::string& where
     s.tf = read_tf(r.at("tf"));
     if (r.has("tf_back")) s.tf_back = read_tf(r.at("tf_back"));
     s.frame = read_frame(r.at("frame"));
+    if (r.has("labels")) {
+        const Reader l = r.at("labels");
+        l.expect_object({"path"});
+        s.labels = l.text("path");
+        if (s.labels->empty()) l.fail(l.sub("path"), "expected a label volume file name, got an empty string");
+    }
+    check_labels(s, where);
     if (s.frame.two_tfs && !s.tf_back)
         r.fail("tf_back", "missing (frame.two_tfs is true: the frame needs the back TF)");
     if (!s.frame.two_tfs && s.tf_back)
@@ -591,6 +655,8 @@ SessionFile load_session_file(const std::string& path) {
     SessionFile s = parse_session_file(text.str(), path);
     const fs::path vp(s.volume.path);
     if (vp.is_relative()) s.volume.path = (fs::path(path).parent_path() / vp).lexically_normal().string();
+    if (s.labels && fs::path(*s.labels).is_relative())
+        s.labels = (fs::path(path).parent_path() / *s.labels).lexically_normal().string();
     return s;
 }
 

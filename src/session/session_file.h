@@ -10,8 +10,9 @@
 // shortest form that reads back to the same double, hence the same float.
 //
 // What it does not hold: the volume's voxels (a path, resolved against the session file's
-// folder when relative) and the segment renderer's label map and table (a session of the
-// segment renderer is refused, by the writer and the reader, until it carries them).
+// folder when relative). A frame of the segment renderer (the viewer's segments toggle, `render
+// --labels`) holds its mode, tint and label table (every label's colour, opacity and visibility)
+// in the frame, and in mask mode the label volume's path beside the volume's ("labels").
 //
 // Errors name the JSON field (invariant 3): "s.json: frame.sampling.step: expected a number, got
 // a string"; unknown keys are errors too (a misspelt key would silently be a default).
@@ -37,18 +38,22 @@ struct SessionFile {
     TransferFunction tf;
     std::optional<TransferFunction> tf_back;  // the back TF of frames with two_tfs
     FrameSpec frame;
+    // The label volume of a segment-renderer frame in mask mode (as stored; relative paths: to
+    // the session file's folder). Required there, refused elsewhere (labels mode reads the
+    // volume itself as its label map).
+    std::optional<std::string> labels;
 };
 
 inline constexpr int kSessionFileVersion = 1;
 
 // The document (pretty-printed JSON, "lacuna_session": 1). Throws lacuna::Error(where, field,
-// ...) for what a session file cannot hold yet (the segment renderer).
+// ...) for a file that would not read back (labels missing or given where they do not belong).
 std::string to_json(const SessionFile& s, const std::string& where = "session");
 // Parses and validates a document (lacuna::validate on the frame; its FrameError comes back as
 // lacuna::Error(where, "frame.<field>", expected)). `where` names the file in errors.
 SessionFile parse_session_file(const std::string& json_text, const std::string& where);
-// Reads a file (at most 16 MiB) and parses it; a relative volume path becomes relative to the
-// file's folder.
+// Reads a file (at most 16 MiB) and parses it; a relative volume (or labels) path becomes
+// relative to the file's folder.
 SessionFile load_session_file(const std::string& path);
 
 }  // namespace lacuna

@@ -140,7 +140,13 @@ TEST(CliSession, MalformedFilesNameTheFieldAndWriteNothing) {
         {"bad tf", [](auto& j) { j["tf"]["opacity"] = "x"; }, ": tf: "},
         {"version", [](auto& j) { j["lacuna_session"] = 2; }, "lacuna_session: expected 1"},
         {"two_tfs without back", [](auto& j) { j["frame"]["two_tfs"] = true; }, "tf_back: missing"},
-        {"segments", [](auto& j) { j["frame"]["renderer"] = "segments"; }, "frame.renderer"},
+        // A segments frame in mask mode names its label volume (the viewer's segments toggle).
+        {"segments without labels",
+         [](auto& j) {
+             j["frame"]["renderer"] = "segments";
+             j["frame"]["structure"] = {{"name", "label-octree"}};
+         },
+         "labels: missing (frame.renderer is segments in mask mode"},
         {"background short", [](auto& j) { j["frame"]["background"] = {0, 0}; },
          "frame.background: expected an array of three numbers"},
         {"gradient points not pairs",

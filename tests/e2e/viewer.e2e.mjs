@@ -8,7 +8,8 @@
 // PNG through the server's own encoder, --jpeg). Saving work: the TF downloaded as lacuna JSON and
 // exported as Slicer .vp.json (both rendered by `lacuna render --tf`) and uploaded back into the
 // editor; the screenshot button's PNG equals `lacuna render --session` of the saved session, byte
-// for byte. Saves a screenshot of the viewer to --screenshot
+// for byte. A 4D NIfTI file: the frame selector switches the server's volume (the frame and the
+// saved session follow). Saves a screenshot of the viewer to --screenshot
 // (default docs/images/viewer.png, the README picture; ctest passes a path in the build folder so
 // a test run leaves the checkout untouched).
 //
@@ -89,6 +90,25 @@ function writeLpsPhantom(path, labels = false) {
     `space origin: (${origin[0]},${origin[1]},${origin[2]})\n\n`;
   writeFileSync(path, Buffer.concat([Buffer.from(header, 'ascii'), data]));
 }
+// A NIfTI-1 file of `frames` uint8 volumes along dim[4] (no qform/sform: pixdim only): in volume
+// f a bright ball of radius 3 + 3f in a faint box, so each volume renders differently.
+function write4dNifti(path, [nx, ny, nz], frames) {
+  const hdr = Buffer.alloc(352);
+  hdr.writeInt32LE(348, 0);
+  [4, nx, ny, nz, frames, 1, 1, 1].forEach((d, i) => hdr.writeInt16LE(d, 40 + 2 * i));
+  hdr.writeInt16LE(2, 70);  // datatype uint8
+  hdr.writeInt16LE(8, 72);  // bitpix
+  for (let i = 0; i < 8; i++) hdr.writeFloatLE(1, 76 + 4 * i);
+  hdr.writeFloatLE(352, 108);  // vox_offset
+  hdr.write('n+1\0', 344, 'latin1');
+  const data = Buffer.alloc(nx * ny * nz * frames);
+  for (let f = 0; f < frames; f++) for (let k = 0; k < nz; k++) for (let j = 0; j < ny; j++) for (let i = 0; i < nx; i++) {
+    const r = Math.hypot(i - nx / 2, j - ny / 2, k - nz / 2);
+    data[((f * nz + k) * ny + j) * nx + i] = r < 3 + 3 * f ? 220 : 30;
+  }
+  writeFileSync(path, Buffer.concat([hdr, data]));
+}
+
 // A faint grey body and, opaque, only the right marker (220) in red: where the patient's right is
 // shows in the picture.
 const kPhantomTf = {
@@ -589,6 +609,79 @@ try {
     const exited2 = new Promise((resolve) => server2.once('exit', (code) => resolve(code)));
     server2.kill('SIGINT');
     check(await exited2 === 0, 'the orientation server stops cleanly');
+    server2 = null;
+  }
+
+  // 4D files (issue 18 item 6): a NIfTI series of three volumes in a server of its own, started
+  // without --frame (volume 0). The frame selector shows; choosing volume 2 makes the server read
+  // it and every later frame is of it: the page's frame is, byte for byte, `lacuna render
+  // --session` of the session the page then saves, which names frame 2; and it differs from the
+  // frame of volume 0.
+  {
+    const series = join(dir, 'series.nii');
+    write4dNifti(series, [24, 22, 20], 3);
+    let server3 = null;
+    const url3 = await spawnServer(series, 'mr-default', (s) => { server3 = s; });
+    server2 = server3;  // fail() kills it
+    const page4 = await context.newPage();
+    page4.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+    page4.on('pageerror', (e) => consoleErrors.push(String(e)));
+    const sent = new Map(), received = new Map(), frameMessages = [];
+    page4.on('websocket', (ws) => {
+      ws.on('framesent', (f) => {
+        if (typeof f.payload !== 'string') return;
+        const m = JSON.parse(f.payload);
+        if (m.type === 'render') sent.set(m.id, m);
+        if (m.type === 'volume_frame') frameMessages.push(m);
+      });
+      ws.on('framereceived', (f) => {
+        if (typeof f.payload === 'string') return;
+        const fr = parseFrame(Buffer.from(f.payload));
+        if (fr.header.type === 'frame') received.set(fr.header.id, fr);
+      });
+    });
+    const latest = () => {
+      const id = Math.max(...[...received.values()].filter((f) => !f.header.preview).map((f) => f.header.id));
+      return { req: sent.get(id), frame: received.get(id) };
+    };
+    await page4.goto(url3);
+    await waitFullFrame(page4, 0);
+    const selector = await page4.evaluate(() => ({
+      display: getComputedStyle(document.getElementById('frame-row')).display,
+      max: document.getElementById('volume-frame').max, value: document.getElementById('volume-frame').value,
+      frames: window.lacunaViewer.hello().frames }));
+    check(selector.display === 'flex' && selector.max === '2' && selector.value === '0' && selector.frames === 3,
+          `a 4D file shows the frame selector (volumes 0..${selector.max}, showing ${selector.value})`);
+    const first = latest().frame.jpeg;
+    const n = await page4.evaluate(() => window.lacunaViewer.frames());
+    await page4.fill('#volume-frame-n', '2');
+    await page4.dispatchEvent('#volume-frame-n', 'change');
+    await page4.waitForFunction(() => window.lacunaViewer.hello().frame === 2, null, { timeout: 30_000 });
+    await waitFullFrame(page4, n);
+    const { req, frame } = latest();
+    check(frameMessages.length === 1 && frameMessages[0].frame === 2 &&
+          (await page4.inputValue('#volume-frame')) === '2',
+          'choosing volume 2 sends one volume_frame message and the slider follows');
+    check(Buffer.compare(frame.jpeg, first) !== 0, 'the frame of volume 2 differs from that of volume 0');
+    const [dl] = await Promise.all([page4.waitForEvent('download', { timeout: 60_000 }), page4.click('#session-save')]);
+    const sessionPath = join(dir, 'series-session.json');
+    await dl.saveAs(sessionPath);
+    const doc = JSON.parse(readFileSync(sessionPath, 'utf8'));
+    check(doc.volume.path === series && doc.volume.frame === 2, `the saved session names frame ${doc.volume.frame}`);
+    // The session at the frame's size: the CLI's image through the server's JPEG encoder.
+    doc.frame.width = req.width;
+    doc.frame.height = req.height;
+    const sized = join(dir, 'series-session-sized.json'), png = join(dir, 'series.png'), jpg = join(dir, 'series.jpg');
+    writeFileSync(sized, JSON.stringify(doc));
+    execFileSync(args.lacuna, ['render', '--session', sized, '--out', png], { stdio: 'ignore' });
+    execFileSync(args.jpeg, [png, jpg], { stdio: 'ignore' });
+    check(Buffer.compare(frame.jpeg, readFileSync(jpg)) === 0,
+          'the frame of volume 2 is lacuna render --session (frame 2) byte for byte');
+    await page4.close();
+    server3.removeAllListeners('exit');
+    const exited3 = new Promise((resolve) => server3.once('exit', (code) => resolve(code)));
+    server3.kill('SIGINT');
+    check(await exited3 === 0, 'the 4D server stops cleanly');
     server2 = null;
   }
 

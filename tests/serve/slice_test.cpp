@@ -140,7 +140,8 @@ TEST(SliceServer, HelloListsTheNewMessages) {
     Client c(server.port);
     const json hello = c.read_text();
     EXPECT_EQ(hello["messages"], json::array({"render", "slice", "probe", "screenshot", "session",
-                                              "tf_export", "tf_import", "session_import"}));
+                                              "tf_export", "tf_import", "session_import",
+                                              "volume_frame"}));
     EXPECT_EQ(hello["slice_views"]["planes"], json::array({"axial", "coronal", "sagittal"}));
     EXPECT_EQ(hello["slice_views"]["interpolations"], json::array({"trilinear", "nearest"}));
     // The world box the page centres its crosshair in: the phantom's, centred on 0 whatever
