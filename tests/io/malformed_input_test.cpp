@@ -12,6 +12,7 @@
 #include "io/io_test_util.h"
 #include "io/nifti_test_file.h"
 #include "lacuna/io.h"
+#include "lacuna/rgb.h"
 
 namespace lacuna {
 namespace {
@@ -372,7 +373,9 @@ TEST(IoMalformed, TimeSeriesNeedAFrameButOneTimePointDoesNot) {
     expect_read_error(dir.file("t3.nii"), {"frame: the file holds 3 volumes along dim[4]; choose one (0..2)"});
 }
 
-TEST(IoMalformed, RgbImagesAreNotScalar) {
+// RGB NRRD is not read (yet); RGB NIfTI is (docs/formats.md, "RGB volumes"), but one whose
+// bitpix disagrees with its datatype is refused naming the field.
+TEST(IoMalformed, RgbNrrdIsNotScalarAndAMisdeclaredRgbNiftiIsRefused) {
     ScratchDir dir;
     std::string text =
         nrrd_header("uint8", "3 4 4 4", 4, "kinds: RGB-color domain domain domain\n") +
@@ -383,7 +386,10 @@ TEST(IoMalformed, RgbImagesAreNotScalar) {
     spec.datatype = 128;  // RGB24
     std::vector<uint8_t> vox(24);
     test::write_bytes(dir.file("rgb.nii"), test::nifti_bytes(spec, vox.data(), vox.size()));
-    expect_read_error(dir.file("rgb.nii"), {"expected a scalar image"});
+    EXPECT_NE(rgb_colours(read_volume(dir.file("rgb.nii"))), nullptr);
+    spec.bitpix = 16;
+    test::write_bytes(dir.file("bad.nii"), test::nifti_bytes(spec, vox.data(), vox.size()));
+    expect_read_error(dir.file("bad.nii"), {"bitpix: expected 24 for RGB24 (datatype 128), got 16"});
 }
 
 TEST(IoMalformed, ComplexImagesAreRejected) {
