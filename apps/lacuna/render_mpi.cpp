@@ -6,6 +6,7 @@
 #include "core/parallel.h"
 #include "dist/comm.h"
 #include "dist/distributed_frame.h"
+#include "io/brick_read.h"
 #include "lacuna/error.h"
 
 namespace lacuna::cli {
@@ -61,11 +62,20 @@ void render_mpi(const MpiRenderJob& job) {
         throw Error("mpirun", "features",
                     "distributed rendering takes no features yet (shading, gradient opacity, "
                     "shadows, clip planes, crop, blend modes, jitter, --tf-back)");
-    // Raw files are read by offset (each rank its brick), every other file whole by each rank.
+    // Files whose voxels lie at an offset are read by offset (each rank its brick,
+    // src/io/brick_read.h), every other file whole by each rank. The header is every rank's
+    // alike: its errors (a truncated file) are thrown here, before any rank waits for another.
+    ReadOptions ro;
+    ro.raw = job.volume.raw_spec ? job.volume.raw_spec : raw_spec_of(job.volume);
+    ro.frame = job.volume.frame;
+    if (!job.volume.max_memory.empty())
+        ro.max_memory.bytes = parse_bytes(job.volume.max_memory, "--max-memory");
+    ro.max_memory.name = "--max-memory";
+    ro.allow_external_data = job.volume.allow_external_data;
     dist::VolumeSource source;
     source.load_whole = [&] { return load_volume(job.volume); };
-    source.raw = dist::raw_brick_file(
-        job.volume.path, job.volume.raw_spec ? job.volume.raw_spec : raw_spec_of(job.volume));
+    source.file = io::open_brick_file(job.volume.path, ro);
+    source.budget = ro.max_memory;
     if (job.volume.range_value)
         source.vis_range = job.volume.range_value;
     else if (!job.volume.range.empty())

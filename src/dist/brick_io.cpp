@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <limits>
 
 #include "lacuna/error.h"
 
@@ -39,70 +39,26 @@ Volume crop_brick(const Volume& whole, Vec3i offset, Vec3i dims) {
 
 namespace lacuna::dist {
 
-namespace {
-bool host_little_endian() {
-    const uint16_t one = 1;
-    uint8_t b;
-    std::memcpy(&b, &one, 1);
-    return b == 1;
-}
-}  // namespace
-
-std::optional<RawBrickFile> raw_brick_file(const std::string& path,
-                                           const std::optional<RawSpec>& raw) {
-    const std::filesystem::path p(path);
-    std::string ext = p.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".raw") return std::nullopt;
-    const std::optional<RawSpec> spec = raw ? raw : raw_spec_from_name(path);
-    if (!spec || spec->type == VoxelType::Float32 || spec->big_endian == host_little_endian())
-        return std::nullopt;
-    // The checks read_volume makes, before any rank reads a byte: a layout it would refuse is
-    // refused alike.
-    for (int a = 0; a < 3; ++a)
-        if (spec->dims[a] < 2 || spec->dims[a] > kMaxDim || !(spec->spacing[a] > 0) ||
-            !std::isfinite(spec->spacing[a]))
-            return std::nullopt;  // read_volume names the problem
-    std::error_code ec;
-    const uint64_t size = std::filesystem::file_size(p, ec);
-    const uint64_t want = uint64_t(spec->dims.x) * uint64_t(spec->dims.y) * uint64_t(spec->dims.z) *
-                          voxel_size(spec->type);
-    if (ec || size != want) return std::nullopt;  // read_volume names it
-    return RawBrickFile{path, *spec};
-}
-
-Volume header_of(const RawBrickFile& f) {
-    Volume v(f.spec.dims, f.spec.type, nullptr, nullptr);
-    v.spacing = f.spec.spacing;
-    return v;
-}
-
-Volume read_brick(const RawBrickFile& f, Vec3i offset, Vec3i dims) {
-    const Vec3i wd = f.spec.dims;
-    for (int a = 0; a < 3; ++a)
-        if (offset[a] < 0 || dims[a] < 2 || offset[a] + dims[a] > wd[a])
-            throw Error("brick", "voxels", "expected a brick inside the volume");
-    std::ifstream in(f.path, std::ios::binary);
-    if (!in) throw Error(f.path, "file", std::string("cannot open: ") + std::strerror(errno));
-    Volume b(dims, f.spec.type, f.path);
-    b.spacing = f.spec.spacing;
-    const size_t vs = voxel_size(f.spec.type);
-    auto* dst = static_cast<char*>(b.data());
-    const std::streamsize row = std::streamsize(size_t(dims.x) * vs);
-    for (int k = 0; k < dims.z; ++k)
-        for (int j = 0; j < dims.y; ++j) {
-            // One row of the brick: voxels offset.x .. offset.x + dims.x - 1 of file row (y, z).
-            const uint64_t at =
-                ((uint64_t(offset.z + k) * uint64_t(wd.y) + uint64_t(offset.y + j)) *
-                     uint64_t(wd.x) +
-                 uint64_t(offset.x)) *
-                vs;
-            in.seekg(std::streamoff(at));
-            in.read(dst + b.index(0, j, k) * vs, row);
-            if (in.gcount() != row) throw Error(f.path, "voxel data", "read error or truncated");
+void finite_minmax(const Volume& v, float& lo, float& hi) {
+    lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    const size_t n = v.voxel_count();
+    visit_voxels(v, [&](const auto* p) {
+        for (size_t i = 0; i < n; ++i) {
+            const float x = float(p[i]);
+            if (std::isnan(x)) continue;
+            lo = std::min(lo, x), hi = std::max(hi, x);
         }
-    b.compute_range(f.path);
-    return b;
+    });
+}
+
+size_t replace_nan(Volume& v, float value) {
+    if (v.type() != VoxelType::Float32) return 0;
+    float* p = v.data_as<float>();
+    size_t n = 0;
+    for (size_t i = 0; i < v.voxel_count(); ++i)
+        if (std::isnan(p[i])) p[i] = value, ++n;
+    v.nan_voxels = n;
+    return n;
 }
 
 ValueRange default_vis_range(float lo, float hi) {

@@ -39,6 +39,8 @@ class Comm {
     void sum_to_root(std::vector<uint32_t>& v);
     // The smallest `lo` and the largest `hi` over every rank, on every rank.
     void minmax(float& lo, float& hi);
+    // The sum of every rank's `v`, on every rank.
+    uint64_t sum(uint64_t v);
     // Every rank's `mine` on every rank, in rank order.
     std::vector<uint8_t> allgather(const void* mine, size_t bytes);
     // Ends every rank of the job with this exit code (after a rank's error: the others may be

@@ -120,6 +120,12 @@ void Comm::minmax(float& lo, float& hi) {
     MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD);
 }
 
+uint64_t Comm::sum(uint64_t v) {
+    if (m_size == 1) return v;
+    MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    return v;
+}
+
 std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     if (bytes > size_t(INT_MAX)) throw Error("mpi", "allgather", "expected under 2 GiB per rank");
     std::vector<uint8_t> all(bytes * size_t(m_size));

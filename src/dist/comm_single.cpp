@@ -39,6 +39,9 @@ std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
 }
 void Comm::sum_to_root(std::vector<uint32_t>&) {}
 void Comm::minmax(float&, float&) {}
+uint64_t Comm::sum(uint64_t v) {
+    return v;
+}
 std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     return gather(mine, bytes);
 }

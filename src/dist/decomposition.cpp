@@ -1,5 +1,6 @@
 #include "dist/decomposition.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -150,6 +151,52 @@ Decomposition decompose_visible(const Volume& v, const TransferLut& lut, int ran
     });
     t.build_from_row_sums();
     return decompose(v.dims(), ranks, [&t](const CellBox& b) { return double(t.count(b)); });
+}
+
+namespace {
+// Step 1 and Eq. 5 of the kd-tree paper's table over the cells of v (decompose_visible's).
+template <class Count>
+void visible_table(const Volume& v, const TransferLut& lut, int threads,
+                   SummedVolumeTable<Count>& t) {
+    int cells[3];
+    cell_counts(v, cells);
+    t.resize(cells);
+    OpacityPrefix prefix;
+    prefix.build(lut);
+    for_each_cell_row(v, lut.map(), 8, threads, [&](const CellRow& r) {
+        Count* row = t.row(r.j, r.k);
+        Count s = 0;
+        for (int i = 0; i < r.n; ++i) {
+            s += Count(prefix.visible(r.lo[i], r.hi[i]));
+            row[i] = s;
+        }
+    });
+    t.build_from_row_sums();
+}
+}  // namespace
+
+SlabCounts::SlabCounts(const Volume& slab, const CellBox& cells, const TransferLut& lut,
+                       int threads)
+    : m_cells(cells), m_narrow(uint64_t(box_volume(cells)) < (uint64_t(1) << 32)) {
+    if (m_narrow)
+        visible_table(slab, lut, threads, m_t32);
+    else
+        visible_table(slab, lut, threads, m_t64);
+}
+
+uint64_t SlabCounts::count(const CellBox& b) const {
+    CellBox c;  // b within this slab, in slab cells
+    for (int a = 0; a < 3; ++a) {
+        c.lo[a] = std::max(b.lo[a], m_cells.lo[a]) - m_cells.lo[a];
+        c.hi[a] = std::min(b.hi[a], m_cells.hi[a]) - m_cells.lo[a];
+        if (c.lo[a] >= c.hi[a]) return 0;
+    }
+    return m_narrow ? uint64_t(m_t32.count(c)) : uint64_t(m_t64.count(c));
+}
+
+Decomposition decompose_visible_slabs(Vec3i dims, const SlabCounts& mine, int ranks,
+                                      const std::function<uint64_t(uint64_t)>& sum) {
+    return decompose(dims, ranks, [&](const CellBox& b) { return double(sum(mine.count(b))); });
 }
 
 BrickOwnership ownership(const Decomposition& d, int rank) {

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "accel/region.h"
+#include "accel/summed_volume_table.h"
 #include "lacuna/math.h"
 #include "lacuna/renderer.h"
 #include "lacuna/transfer_function.h"
@@ -72,6 +73,30 @@ Decomposition decompose_voxels(Vec3i dims, int ranks);
 // Balanced on the cells `lut` can make visible (TF opacity > 0 somewhere in the cell's value
 // range); falls back to cells for a node holding no visible cell.
 Decomposition decompose_visible(const Volume& v, const TransferLut& lut, int ranks, int threads);
+// The same tree when each rank holds only its slab of the volume: the voxels of `cells` (plus
+// the ghost layer), boxes that over the ranks partition the grid's cells (the bricks of
+// decompose_voxels). A box's weight is the sum over the ranks of its visible cells inside their
+// slabs, each counted by the slab's own summed-volume table (SlabCounts, built first: it may
+// fail, the sums may not), and `sum` adds them up over the ranks (an allreduce: every rank makes
+// the same calls in the same order, since every rank builds the same tree from the same sums).
+// For integer voxels the tree is decompose_visible's over the whole volume; for float voxels
+// the cells' corner ranges are widened relative to the slab's data range, not the whole's
+// (cell_ranges.h), which can move a cell within ulps of a TF edge, and so a plane.
+class SlabCounts {
+  public:
+    SlabCounts(const Volume& slab, const CellBox& cells, const TransferLut& lut, int threads);
+    // Visible cells of the whole-grid box `b` inside this slab.
+    uint64_t count(const CellBox& b) const;
+    size_t bytes() const { return m_t32.bytes() + m_t64.bytes(); }
+
+  private:
+    CellBox m_cells;
+    bool m_narrow;
+    SummedVolumeTable<uint32_t> m_t32;  // when the slab's cells fit 32 bits (the table's rule)
+    SummedVolumeTable<uint64_t> m_t64;
+};
+Decomposition decompose_visible_slabs(Vec3i dims, const SlabCounts& mine, int ranks,
+                                      const std::function<uint64_t(uint64_t)>& sum);
 
 // The owned box of `rank` and the voxels it reads: offset = brick.lo, dims = brick.hi - lo + 1.
 BrickOwnership ownership(const Decomposition& d, int rank);

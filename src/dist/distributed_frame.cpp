@@ -3,6 +3,7 @@
 #include <sched.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -68,30 +69,34 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
     auto t0 = Clock::now();
     Box3f whole_bounds;
     Volume brick;
+    ValueRange vis{};
+    std::optional<SlabCounts> counts;
     BrickOwnership own;
-    const bool by_offset = source.raw && options.balance == Balance::Voxels;
+    const bool by_offset = source.file.has_value();
+    const bool visible = options.balance == Balance::Visible;
     float lo = 0, hi = 0;
     std::exception_ptr failed;
     std::string what;
     try {
         if (by_offset) {
-            // By offset: the header alone gives the grid; each rank reads its brick, then all
-            // agree on the whole volume's range from their bricks' (which cover every voxel).
-            const Volume header = header_of(*source.raw);
+            // By offset: the header alone gives the grid; each rank reads its brick (for a
+            // visible balance first its slab of the voxel-balanced tree), then all agree on the
+            // whole volume's range from their voxels' (which cover every voxel).
+            const Volume& header = source.file->header;
             whole_bounds = world_bounds(header);
             out.whole_voxels = header.voxel_count();
             out.decomposition = decompose_voxels(header.dims(), comm.size());
             own = ownership(out.decomposition, comm.rank());
-            brick =
-                read_brick(*source.raw, own.offset, brick_voxels(out.decomposition, comm.rank()));
+            brick = io::read_brick(*source.file, own.offset,
+                                   brick_voxels(out.decomposition, comm.rank()), source.budget);
             me.voxels_read = brick.voxel_count();
-            lo = brick.data_range().min, hi = brick.data_range().max;
+            finite_minmax(brick, lo, hi);
         } else {
             const Volume whole = source.load_whole();
             whole_bounds = world_bounds(whole);
             out.whole_voxels = whole.voxel_count();
             me.voxels_read = whole.voxel_count();
-            out.decomposition = options.balance == Balance::Visible
+            out.decomposition = visible
                                     ? decompose_visible(whole, discretise(tf, whole.vis_range()),
                                                         comm.size(), threads)
                                     : decompose_voxels(whole.dims(), comm.size());
@@ -104,8 +109,55 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
     }
     agree(comm, failed, what);
     if (by_offset) {
+        // What read_volume does with the whole volume (brick_io.h): the range, NaN as its
+        // smallest value, the visualization range; for a visible balance, the visible cells of
+        // this rank's slab (the brick just read), the tree of them and this rank's brick of it.
         comm.minmax(lo, hi);
-        brick.set_vis_range(source.vis_range ? *source.vis_range : default_vis_range(lo, hi));
+        const std::string& path = source.file->path;
+        auto finish = [&](Volume& v) {  // read_volume's last steps, with the whole volume's values
+            replace_nan(v, lo);
+            v.compute_range(path);
+            v.set_vis_range(vis);
+        };
+        try {
+            if (!(lo <= hi))
+                throw Error(path, "voxel values",
+                            "expected at least one voxel that is not NaN, got NaN only");
+            vis = source.vis_range ? *source.vis_range : default_vis_range(lo, hi);
+            finish(brick);
+            if (visible)
+                counts.emplace(brick, out.decomposition.bricks[size_t(comm.rank())],
+                               discretise(tf, vis), threads);
+        } catch (const std::exception& e) {
+            failed = std::current_exception();
+            what = e.what();
+        }
+        agree(comm, failed, what);
+        if (visible) {
+            // The tree of the visible cells from every slab's counts; this rank's brick of it
+            // (the slab itself when the box is the same).
+            const CellBox slab = out.decomposition.bricks[size_t(comm.rank())];
+            out.decomposition =
+                decompose_visible_slabs(source.file->header.dims(), *counts, comm.size(),
+                                        [&](uint64_t v) { return comm.sum(v); });
+            counts.reset();
+            own = ownership(out.decomposition, comm.rank());
+            const CellBox& c = out.decomposition.bricks[size_t(comm.rank())];
+            try {
+                if (!std::equal(c.lo, c.lo + 3, slab.lo) || !std::equal(c.hi, c.hi + 3, slab.hi)) {
+                    brick = Volume();  // the slab's voxels go before the brick's come
+                    brick =
+                        io::read_brick(*source.file, own.offset,
+                                       brick_voxels(out.decomposition, comm.rank()), source.budget);
+                    me.voxels_read += brick.voxel_count();
+                    finish(brick);
+                }
+            } catch (const std::exception& e) {
+                failed = std::current_exception();
+                what = e.what();
+            }
+            agree(comm, failed, what);
+        }
     }
     me.load_seconds = seconds_since(t0);
     me.voxels = brick.voxel_count();
@@ -136,6 +188,9 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
         me.cpu_seconds = r.stats.cpu_seconds;
         me.samples = r.stats.samples;
         me.rays = r.stats.rays;
+        // Compositing starts when every rank has rendered, so its time is its own (not the wait
+        // for the slowest render, which the frame's time holds).
+        comm.barrier();
         // 3. Compositing in the kd-tree's order for this view (eye and ray direction in whole index
         // space: the volume frame over the spacing).
         const Camera cam = to_volume_frame(volume_frame(session->volume()), session->camera(f));

@@ -3,7 +3,11 @@
 // Every rank calls render_distributed with the same FrameSpec and TF (the CLI's flags, parsed the
 // same way on every rank). Each rank
 //   1. loads its brick (brick_io.h) of the decomposition (decomposition.h), computed the same way
-//      on every rank from the whole grid (and, for Balance::Visible, the TF);
+//      on every rank from the whole grid (and, for Balance::Visible, the TF). By offset with
+//      Balance::Visible, a rank first reads its slab (its brick of the voxel-balanced tree),
+//      counts the visible cells of the slab, and the ranks build the visible tree from the sums
+//      of their counts (decompose_visible_slabs); then it reads its brick of that tree (the slab
+//      kept when they are the same box);
 //   2. runs an ordinary Session over the brick (Session::set_brick): the structure of the frame is
 //      built over the brick, and the ray marcher takes only the brick's owned samples of the whole
 //      grid's lattice (render/ownership.h), without early ray termination;
@@ -42,11 +46,12 @@ struct RankReport {
     double load_seconds = 0;       // read the file and cut the brick out
     double build_seconds = 0;      // the brick's structure (and its per-TF refinement)
     double render_seconds = 0;     // the rank's owned samples
-    double composite_seconds = 0;  // this rank's part of compositing
+    double composite_seconds = 0;  // this rank's part of compositing (after every render)
     double cpu_seconds = 0;        // CPU time of the render (all its threads)
     uint64_t samples = 0, rays = 0;
     uint64_t voxels = 0;       // voxels of the brick (ghost layer included)
-    uint64_t voxels_read = 0;  // voxels read from the file (the brick's, or the whole file's)
+    uint64_t voxels_read = 0;  // voxels read from the file (the brick's (and with --balance
+                               // visible the slab's), or the whole file's)
     uint64_t visible_cells =
         0;  // cells of the brick's box the TF can make visible (0: not counted)
     uint64_t bytes_sent = 0;
@@ -71,7 +76,8 @@ using VolumeLoader = std::function<Volume()>;
 // Where the ranks' voxels come from (brick_io.h).
 struct VolumeSource {
     VolumeLoader load_whole;              // any file: read whole by every rank, the brick cut out
-    std::optional<RawBrickFile> raw;      // set: bricks read by offset (with Balance::Voxels)
+    std::optional<io::BrickFile> file;    // set: bricks read by offset (src/io/brick_read.h)
+    MemoryBudget budget;                  // what a rank may read by offset (--max-memory)
     std::optional<ValueRange> vis_range;  // the front end's visualization range (--range), if any
 };
 

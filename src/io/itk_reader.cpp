@@ -88,7 +88,7 @@ std::string geometry_source(const std::string& path) {
 
 }  // namespace
 
-Volume read_itk(const std::string& path, const ReadOptions& opts) {
+Volume read_itk(const std::string& path, const ReadOptions& opts, VoxelLayout* header_only) {
     init_itk();
     // ITK's libraries print to std::cerr; capture it while ITK runs (never around our own
     // progress callback) and append it to the error if the call fails.
@@ -145,7 +145,7 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
     const uint64_t data_bytes = grid_bytes(dims, disk_type_size(disk));
     const uint64_t volume_bytes = grid_bytes(dims, voxel_size(stored_type(disk)));
     const std::string what = dims_string(dims) + " " + to_string(disk);
-    check_budget(path, "dims", what, volume_bytes, opts.max_memory);
+    if (!header_only) check_budget(path, "dims", what, volume_bytes, opts.max_memory);
     std::optional<MetaDataLayout> meta;
     if (auto* mio = dynamic_cast<itk::MetaImageIO*>(io.GetPointer())) {
         MetaImage* mi = mio->GetMetaImagePointer();
@@ -158,11 +158,12 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
                            disk_type_size(disk) > 1 && big != host_is_big_endian());
     }
     // Voxels NrrdIO reads and that need conversion pass through a full-size temporary.
-    if (!meta && disk != disk_type_of(stored_type(disk)))
+    if (!header_only && !meta && disk != disk_type_of(stored_type(disk)))
         check_budget(path, "dims", what + " (converted through a temporary)",
                      sat_add(volume_bytes, data_bytes), opts.max_memory);
 
-    Volume v(dims, stored_type(disk), path);
+    Volume v = header_only ? Volume(dims, stored_type(disk), nullptr, nullptr)
+                           : Volume(dims, stored_type(disk), path);
     copy_geometry(*io, v);
     v.geometry_source = geometry_source(path);
     if (dynamic_cast<itk::NrrdImageIO*>(io.GetPointer()) && apply_nrrd_las_space(path, v))
@@ -170,6 +171,13 @@ Volume read_itk(const std::string& path, const ReadOptions& opts) {
             "NRRD space directions and space origin (left-anterior-superior space, converted to "
             "LPS by lacuna)";
     if (meta_orientation) apply_anatomical_orientation(*meta_orientation, v, path);
+    if (header_only) {
+        *header_only = {};
+        if (meta)
+            *header_only = {meta->path, uint64_t(meta->offset), disk, meta->swap,
+                            !meta->compressed};
+        return v;
+    }
     if (meta) {
         quiet.reset();
         read_metaimage_voxels(*meta, disk, v, path, opts.progress);

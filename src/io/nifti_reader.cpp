@@ -524,7 +524,8 @@ NiftiFiles nifti_files(const std::string& path) {
 
 }  // namespace
 
-Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity rgb_opacity) {
+Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity rgb_opacity,
+                  VoxelLayout* header_only) {
     const NiftiFiles files = nifti_files(path);
     GzFile hf(gzopen(files.header.c_str(), "rb"));
     if (!hf) throw Error(files.header, "file", std::string("cannot open: ") + std::strerror(errno));
@@ -553,11 +554,14 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity r
     // chosen volume starts `frame` volumes after vox_offset (frames are stored one after another).
     const uint64_t data_bytes = grid_bytes(dims, channels ? channels : disk_type_size(disk));
     const uint64_t offset = sat_add(uint64_t(h.vox_offset), sat_mul(uint64_t(frame), data_bytes));
-    check_budget(path, "dims",
-                 dims_string(dims) + " " + (channels ? std::string(channels == 3 ? "RGB24" : "RGBA32")
-                                                     : to_string(type)),
-                 grid_bytes(dims, channels ? rgb_bytes_per_voxel(rgb_opacity) : voxel_size(type)),
-                 opts.max_memory);
+    if (channels && header_only)
+        throw Error(path, "datatype", "RGB volumes are read whole, not by brick (distributed frames)");
+    if (!header_only)
+        check_budget(path, "dims",
+                     dims_string(dims) + " " +
+                         (channels ? std::string(channels == 3 ? "RGB24" : "RGBA32") : to_string(type)),
+                     grid_bytes(dims, channels ? rgb_bytes_per_voxel(rgb_opacity) : voxel_size(type)),
+                     opts.max_memory);
 
     // An uncompressed file's length is known: report truncation before allocating. A
     // compressed one is inflated incrementally into the buffer, whose pages are only touched
@@ -574,9 +578,16 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity r
                             std::to_string(file_bytes > offset ? file_bytes - offset : 0));
     }
 
-    Volume v = channels ? rgb_volume(dims, channels, rgb_opacity, path) : Volume(dims, type, path);
+    Volume v = header_only ? Volume(dims, type, nullptr, nullptr)
+               : channels  ? rgb_volume(dims, channels, rgb_opacity, path)
+                           : Volume(dims, type, path);
     set_geometry(h, v, path);
     check_geometry(v, path);  // before the voxels are read
+    if (header_only) {
+        *header_only = {data_path, offset, disk, h.swap, gzdirect(f) != 0, rescale, h.slope,
+                        h.inter};
+        return v;
+    }
     // (a compressed file is inflated up to the offset; gzseek says -1 if the stream ends first)
     if (offset > uint64_t(std::numeric_limits<z_off_t>::max()) ||
         gzseek(f, z_off_t(offset), SEEK_SET) != z_off_t(offset))

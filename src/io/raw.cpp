@@ -40,7 +40,7 @@ std::optional<RawSpec> raw_spec_from_name(const std::string& path) {
 
 namespace io {
 
-Volume read_raw(const std::string& path, const ReadOptions& opts) {
+Volume read_raw(const std::string& path, const ReadOptions& opts, VoxelLayout* header_only) {
     std::optional<RawSpec> spec = opts.raw ? opts.raw : raw_spec_from_name(path);
     if (!spec)
         throw Error(path, "raw layout",
@@ -58,8 +58,9 @@ Volume read_raw(const std::string& path, const ReadOptions& opts) {
     }
     // The size and budget checks come before the allocation, so a wrong name costs nothing.
     const uint64_t expected = grid_bytes(spec->dims, voxel_size(spec->type));
-    check_budget(path, "dims", dims_string(spec->dims) + " " + to_string(spec->type), expected,
-                 opts.max_memory);
+    if (!header_only)
+        check_budget(path, "dims", dims_string(spec->dims) + " " + to_string(spec->type), expected,
+                     opts.max_memory);
     std::error_code ec;
     const uint64_t actual = std::filesystem::file_size(path, ec);
     if (ec) throw Error(path, "file", "cannot read its size: " + ec.message());
@@ -69,6 +70,13 @@ Volume read_raw(const std::string& path, const ReadOptions& opts) {
                         std::to_string(spec->dims.z) + " " + to_string(spec->type) +
                         " volume needs " + std::to_string(expected) + " bytes, the file has " +
                         std::to_string(actual));
+    if (header_only) {
+        *header_only = {path, 0, disk_type_of(spec->type), spec->big_endian != host_is_big_endian(),
+                        true};
+        Volume h(spec->dims, spec->type, nullptr, nullptr);
+        h.spacing = spec->spacing;
+        return h;
+    }
 
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, "file", std::string("cannot open: ") + std::strerror(errno));

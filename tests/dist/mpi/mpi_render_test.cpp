@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -127,33 +129,131 @@ TEST(MpiRender, OnlyRankZeroWritesAndReports) {
         EXPECT_NE(m.out.find("\n   " + std::to_string(r) + " "), std::string::npos) << m.out;
 }
 
-// A raw file is read by offset: each rank reads its brick (the read% column of --rank-times),
-// and the frame is the one-process frame, the visualization range agreed from the bricks'.
+// The --rank-times rows: rank, voxels% and read% of each.
+struct RankRow {
+    int rank;
+    double voxels, read;
+};
+std::vector<RankRow> rank_rows(const std::string& out) {
+    std::vector<RankRow> rows;
+    for (size_t p = out.find("\n"); p != std::string::npos; p = out.find("\n", p + 1)) {
+        RankRow r;
+        double f[5];
+        unsigned long long samples;
+        if (std::sscanf(out.c_str() + p + 1, "%d %lf %lf %lf %lf %lf %llu %lf %lf", &r.rank, &f[0],
+                        &f[1], &f[2], &f[3], &f[4], &samples, &r.voxels, &r.read) == 9)
+            rows.push_back(r);
+    }
+    return rows;
+}
+
+// A file whose voxels lie at an offset is read by offset: each rank reads its brick (the read%
+// column of --rank-times is its voxels%), and the frame is the one-process frame, the range
+// agreed from the bricks'. With --balance visible a rank reads its slab of the voxel tree first,
+// then its brick of the visible tree (read% = the two shares, or one when they are the same box).
+void check_by_offset(const fs::path& volume, const std::string& tag, int n,
+                     const std::string& balance) {
+    const std::string frame = std::string(kFrame) + " --accel bitfield --balance " + balance;
+    check_frames(volume.string(), frame, tag + "_" + balance, {n}, {"direct"});
+    const CliResult m = run_mpi(n, "render " + volume.string() + " " + frame +
+                                       " --rank-times --out " + (dir() / "offset.png").string());
+    ASSERT_EQ(m.code, 0) << m.err;
+    const std::vector<RankRow> rows = rank_rows(m.out);
+    EXPECT_EQ(int(rows.size()), n) << m.out;
+    for (const RankRow& r : rows) {
+        if (balance == "voxels") {
+            EXPECT_EQ(r.read, r.voxels) << tag << m.out;  // the brick, not the file
+            EXPECT_LT(r.read, 100.0 / n + 10.0) << tag << m.out;
+        } else {
+            EXPECT_GE(r.read, r.voxels) << tag << m.out;
+            EXPECT_LT(r.read - r.voxels, 100.0 / n + 10.0) << tag << m.out;  // the slab
+            EXPECT_LT(r.read, 100.0) << tag << m.out;
+        }
+    }
+}
+
 TEST(MpiRender, RawBricksAreReadByOffset) {
     const fs::path raw = dir() / "shells_45x38x52_uint8.raw";
     ASSERT_EQ(
         run_cli("generate sphere-shells --dims 45x38x52 --out " + raw.string() + " --quiet", dir())
             .code,
         0);
-    for (int n : {2, 4}) {
-        check_frames(raw.string(), std::string(kFrame) + " --accel bitfield",
-                     "raw" + std::to_string(n), {n}, {"direct"});
-        const CliResult m = run_mpi(n, "render " + raw.string() + " " + kFrame +
-                                           " --rank-times --out " + (dir() / "raw.png").string());
-        ASSERT_EQ(m.code, 0) << m.err;
-        int rows = 0;
-        for (size_t p = m.out.find("\n"); p != std::string::npos; p = m.out.find("\n", p + 1)) {
-            int rank;
-            double f[7], voxels, read;
-            unsigned long long samples;
-            if (std::sscanf(m.out.c_str() + p + 1, "%d %lf %lf %lf %lf %lf %llu %lf %lf", &rank,
-                            &f[0], &f[1], &f[2], &f[3], &f[4], &samples, &voxels, &read) == 9) {
-                ++rows;
-                EXPECT_EQ(read, voxels) << m.out;  // the brick, not the file
-                EXPECT_LT(read, 100.0 / n + 10.0) << m.out;
-            }
-        }
-        EXPECT_EQ(rows, n) << m.out;
+    for (int n : {2, 4}) check_by_offset(raw, "raw" + std::to_string(n), n, "voxels");
+    check_by_offset(raw, "raw3", 3, "visible");
+}
+
+// Every format with voxels at an offset, each in another voxel type: NRRD attached and
+// detached, MetaImage .mha and .mhd, NIfTI, float and big-endian raw.
+TEST(MpiRender, EveryOffsetFormatIsReadByOffset) {
+    const std::pair<const char*, const char*> files[] = {
+        {"shells.nrrd", "uint16"}, {"shells.nhdr", "int16"},
+        {"shells.mha", "float32"}, {"shells.mhd", "uint8"},
+        {"shells.nii", "int16"},   {"shells_45x38x52_float32.raw", "float32"}};
+    for (const auto& [name, type] : files) {
+        const fs::path p = dir() / ("fmt_" + std::string(name));
+        ASSERT_EQ(run_cli("generate sphere-shells --dims 45x38x52 --type " + std::string(type) +
+                              " --out " + p.string() + " --quiet",
+                          dir())
+                      .code,
+                  0)
+            << name;
+        check_by_offset(p, name, 3, "voxels");
+        check_by_offset(p, name, 4, "visible");
+    }
+    // Big-endian: the uint16 raw file's bytes swapped, named _be.
+    const fs::path le = dir() / "be_45x38x52_uint16.raw", be = dir() / "be_45x38x52_uint16_be.raw";
+    ASSERT_EQ(run_cli("generate sphere-shells --dims 45x38x52 --type uint16 --out " + le.string() +
+                          " --quiet",
+                      dir())
+                  .code,
+              0);
+    std::string bytes = slurp_file(le);
+    for (size_t i = 0; i + 1 < bytes.size(); i += 2) std::swap(bytes[i], bytes[i + 1]);
+    std::ofstream(be, std::ios::binary) << bytes;
+    check_by_offset(be, "be", 2, "voxels");
+    check_by_offset(be, "be", 3, "visible");
+}
+
+// NaN voxels of a float file read by offset become the whole volume's smallest value (not the
+// brick's), as in one process.
+TEST(MpiRender, NanVoxelsReadByOffsetAreTheWholeVolumesMinimum) {
+    const fs::path f = dir() / "nan_45x38x52_float32.raw";
+    ASSERT_EQ(run_cli("generate sphere-shells --dims 45x38x52 --type float32 --out " + f.string() +
+                          " --quiet",
+                      dir())
+                  .code,
+              0);
+    std::string bytes = slurp_file(f);
+    const float nan = NAN;
+    for (size_t i = 0; i + 4 <= bytes.size(); i += 4 * 5) std::memcpy(&bytes[i], &nan, 4);
+    std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
+    check_by_offset(f, "nan", 4, "voxels");
+    check_by_offset(f, "nan", 3, "visible");
+}
+
+// A truncated file read by offset fails from its header on every rank alike: one line from rank
+// 0, exit 2, no abort, no image.
+TEST(MpiRender, TruncatedOffsetFilesAreOneLineFromRankZero) {
+    for (const char* name : {"tr.nrrd", "tr.mha", "tr.nii", "tr_45x38x52_float32.raw"}) {
+        const fs::path p = dir() / name;
+        ASSERT_EQ(run_cli("generate sphere-shells --dims 45x38x52 --type float32 --out " +
+                              p.string() + " --quiet",
+                          dir())
+                      .code,
+                  0);
+        fs::resize_file(p, fs::file_size(p) - 1000);
+        const fs::path png = dir() / "truncated.png";
+        const CliResult m =
+            run_mpi(3, "render " + p.string() + " " + kFrame + " --out " + png.string());
+        EXPECT_EQ(m.code, 2) << name << ": " << m.err;
+        size_t lines = 0;
+        for (size_t q = m.err.find("lacuna:"); q != std::string::npos;
+             q = m.err.find("lacuna:", q + 1))
+            ++lines;
+        EXPECT_EQ(lines, 1u) << name << ": " << m.err;
+        EXPECT_NE(m.err.find(p.filename().string()), std::string::npos) << name << ": " << m.err;
+        EXPECT_EQ(m.err.find("MPI_ABORT"), std::string::npos) << m.err;
+        EXPECT_FALSE(fs::exists(png)) << name;
     }
 }
 
