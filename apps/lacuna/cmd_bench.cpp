@@ -207,6 +207,8 @@ void register_bench(CLI::App& app) {
     register_bench_li(*cmd);
     void register_bench_vtk(CLI::App&);  // cmd_bench_vtk.cpp
     register_bench_vtk(*cmd);
+    void register_bench_mpi(CLI::App&);  // bench_mpi.cpp (in the executable: it uses src/dist/)
+    register_bench_mpi(*cmd);
 
     auto a = std::make_shared<FaludiArgs>();
     auto* f = cmd->add_subcommand(

@@ -74,12 +74,22 @@ void send_rect(Comm& comm, int to, int tag, const Partial& p, const Rect& r, Com
 }
 
 // Receives a header and its pixels.
-Rect recv_rect(Comm& comm, int from, int tag, std::vector<float>& px) {
+Rect recv_rect(Comm& comm, int from, int tag, std::vector<float>& px, CompositeStats& st) {
     Rect r;
     comm.recv(from, tag, &r, sizeof r);
     px.assign(size_t(r.pixels()) * 4, 0.f);
-    if (!r.empty()) comm.recv(from, tag + 1, px.data(), px.size() * sizeof(float));
+    st.messages_received += 1, st.bytes_received += sizeof r;
+    if (!r.empty()) {
+        comm.recv(from, tag + 1, px.data(), px.size() * sizeof(float));
+        st.messages_received += 1, st.bytes_received += px.size() * sizeof(float);
+    }
     return r;
+}
+
+// composite_into, counted.
+void over(Partial& dst, const Rect& r, const float* src, bool src_in_front, CompositeStats& st) {
+    composite_into(dst, r, src, src_in_front);
+    st.pixels_composited += uint64_t(r.pixels());
 }
 
 }  // namespace
@@ -100,11 +110,11 @@ Partial composite_direct(Comm& comm, const Partial& mine, const std::vector<int>
             if (q == 0) {
                 const Rect r = nonempty_rect(mine, whole);
                 const std::vector<float> own = pack(mine, r);
-                composite_into(out, r, own.data(), false);
+                over(out, r, own.data(), false, st);
                 continue;
             }
-            const Rect r = recv_rect(comm, q, kTagDirect, px);
-            composite_into(out, r, px.data(), false);
+            const Rect r = recv_rect(comm, q, kTagDirect, px, st);
+            over(out, r, px.data(), false, st);
         }
     }
     st.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -124,8 +134,8 @@ static bool fold_extras(Comm& comm, Partial& mine, const Decomposition& d, Vec3f
     if (rank < extras) {
         std::vector<float> px;
         const KdNode& pair = d.nodes[size_t(slot_node(d, rank, rank + 1))];
-        const Rect r = recv_rect(comm, rank + p, kTagFold, px);
-        composite_into(mine, r, px.data(), !low_in_front(pair, eye, dir, orthographic));
+        const Rect r = recv_rect(comm, rank + p, kTagFold, px, st);
+        over(mine, r, px.data(), !low_in_front(pair, eye, dir, orthographic), st);
     }
     return false;
 }
@@ -163,7 +173,8 @@ Partial composite_binary_swap(Comm& comm, Partial mine, const Decomposition& d, 
         comm.sendrecv(partner, kTagSwap + 1, out_px.data(), out_px.size() * sizeof(float),
                       px.data(), px.size() * sizeof(float));
         st.bytes_sent += sizeof out_r + out_px.size() * sizeof(float);
-        composite_into(mine, in_r, px.data(), partner_front);
+        st.messages_received += 2, st.bytes_received += sizeof in_r + px.size() * sizeof(float);
+        over(mine, in_r, px.data(), partner_front, st);
         r0 = keep.y0, r1 = keep.y1;
     }
     // 3. Rank 0 gathers the strips.
@@ -177,10 +188,10 @@ Partial composite_binary_swap(Comm& comm, Partial mine, const Decomposition& d, 
     out.width = mine.width, out.height = mine.height;
     out.rgba.assign(mine.rgba.size(), 0.f);
     const std::vector<float> own = pack(mine, strip);
-    composite_into(out, strip, own.data(), true);
+    over(out, strip, own.data(), true, st);
     for (int q = 1; q < p; ++q) {
-        const Rect r = recv_rect(comm, q, kTagGather, px);
-        composite_into(out, r, px.data(), true);  // over zero: a copy
+        const Rect r = recv_rect(comm, q, kTagGather, px, st);
+        over(out, r, px.data(), true, st);  // over zero: a copy
     }
     return done(std::move(out));
 }
@@ -241,6 +252,8 @@ Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3
             comm.sendrecv(peer, kTagSwap + 1, out_px.data(), out_px.size() * sizeof(float),
                           in_px.data(), in_px.size() * sizeof(float));
             st.bytes_sent += sizeof out_r + out_px.size() * sizeof(float);
+            st.messages_received += 2,
+                st.bytes_received += sizeof in_r + in_px.size() * sizeof(float);
             rects[size_t(other)] = in_r;
         }
         // Front to back over zero in the block's visibility order, then back into `mine`.
@@ -248,7 +261,7 @@ Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3
             std::fill_n(acc.at(0, y), size_t(mine.width) * 4, 0.f);
         for (int q : block_order(d, a, a + unit * g, unit, eye, dir, orthographic)) {
             const int digit = q - a / unit;
-            composite_into(acc, rects[size_t(digit)], pieces[size_t(digit)].data(), false);
+            over(acc, rects[size_t(digit)], pieces[size_t(digit)].data(), false, st);
         }
         for (int y = keep.y0; y < keep.y1; ++y)
             std::copy_n(acc.at(0, y), size_t(mine.width) * 4, mine.at(0, y));
@@ -266,10 +279,10 @@ Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3
     out.width = mine.width, out.height = mine.height;
     out.rgba.assign(mine.rgba.size(), 0.f);
     const std::vector<float> own = pack(mine, strip);
-    composite_into(out, strip, own.data(), true);
+    over(out, strip, own.data(), true, st);
     for (int q = 1; q < p; ++q) {
-        const Rect r = recv_rect(comm, q, kTagGather, px);
-        composite_into(out, r, px.data(), true);
+        const Rect r = recv_rect(comm, q, kTagGather, px, st);
+        over(out, r, px.data(), true, st);
     }
     return done(std::move(out));
 }

@@ -64,6 +64,10 @@ void composite_into(Partial& dst, const Rect& r, const float* src, bool src_in_f
 struct CompositeStats {
     uint64_t bytes_sent = 0;
     double seconds = 0;
+    // What this rank received and composited (the regressors of composite_model.h): messages
+    // (a rectangle's header and its pixels are two), their bytes, and the pixels it put through
+    // over (composite_into).
+    uint64_t messages_received = 0, bytes_received = 0, pixels_composited = 0;
 };
 
 // Rank 0 gets the composited image (every rank passes its partial); the other ranks an empty

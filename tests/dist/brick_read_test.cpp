@@ -207,8 +207,13 @@ TEST(BrickRead, VisibleTreeFromSlabsIsTheWholeVolumesTree) {
     tf.color = {{0.0, 1.f, 1.f, 1.f}, {1.0, 1.f, 1.f, 1.f}};
     tf.opacity = {{0.0, 0.f}, {0.55, 0.f}, {0.6, 0.7f}, {0.7, 0.f}, {1.0, 0.f}};
     for (VoxelType t : {VoxelType::UInt8, VoxelType::UInt16}) {
-        const Volume whole = shells(t);
+        SyntheticOptions o;
+        o.dims = {40, 36, 44};
+        o.type = t;
+        o.threads = 1;
+        const Volume whole = generate(SyntheticKind::Tree, o);  // lopsided: trees differ
         const TransferLut lut = discretise(tf, whole.vis_range());
+        int differ = 0;
         for (int n : {2, 3, 4, 7}) {
             const Decomposition want = decompose_visible(whole, lut, n, 1);
             const Decomposition slabs = decompose_voxels(whole.dims(), n);
@@ -225,8 +230,9 @@ TEST(BrickRead, VisibleTreeFromSlabsIsTheWholeVolumesTree) {
                 return double(s);
             });
             EXPECT_EQ(to_string(all), to_string(want)) << n << " ranks";
-            EXPECT_NE(to_string(all), to_string(slabs)) << n << " ranks: not the voxel tree";
+            differ += to_string(all) != to_string(slabs);
         }
+        EXPECT_GT(differ, 0) << "every visible tree is the voxel tree: the test shows nothing";
     }
 }
 

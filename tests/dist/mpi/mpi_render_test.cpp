@@ -309,5 +309,21 @@ TEST(MpiRender, LoadFailuresAreOneLineFromRankZero) {
     }
 }
 
+// `lacuna bench mpi` runs (tiny sizes): its report has the scaling rows and the compositing
+// counts of composite.cpp equal the model's (composite_model.h). Times are not checked.
+TEST(MpiRender, BenchMpiRunsAndItsCountsAreTheModels) {
+    const fs::path out = dir() / "bench";
+    const CliResult r = run_cli("bench mpi --quick --mpirun " + std::string(LACUNA_MPIEXEC) +
+                                    " --out-dir " + out.string(),
+                                dir());
+    ASSERT_EQ(r.code, 0) << r.err << r.out;
+    const std::string md = slurp_file(out / "mpi.md");
+    for (const char* want :
+         {"## Strong scaling", "## Weak scaling", "| 1 | tree_40x40x40_uint8.raw |",
+          "| 2 | tree_40x40x40_uint8.raw |", "| 2 | tree_48x24x24_uint8.raw |",
+          "every count equals the model's", "| radix-k | 3 | 64² |", "| 1024 |"})
+        EXPECT_NE(md.find(want), std::string::npos) << want << "\n" << md;
+}
+
 }  // namespace
 }  // namespace lacuna::test
