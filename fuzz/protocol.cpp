@@ -25,7 +25,8 @@ namespace {
 void check_view(const serve::ViewRequest& req, const serve::Limits& limits) {
     fuzz_check(req.width >= 1 && req.width <= limits.max_side && req.height >= 1 &&
                    req.height <= limits.max_side,
-               "image size within limits", std::to_string(req.width) + "x" + std::to_string(req.height));
+               "image size within limits",
+               std::to_string(req.width) + "x" + std::to_string(req.height));
     const TransferLut lut = discretise(req.tf, ValueRange{-1024.f, 3071.f});
     const ValueToLut map = lut.map();
     for (float v : {lut.vis.min, lut.vis.max, -3e38f, 3e38f, 0.f}) {
@@ -42,7 +43,9 @@ void check_view(const serve::ViewRequest& req, const serve::Limits& limits) {
 void answer(const std::string& text, const serve::Limits& limits) {
     using serve::MessageKind;
     switch (serve::message_kind(text, limits)) {
-        case MessageKind::Render: check_view(serve::parse_request(text, limits), limits); return;
+        case MessageKind::Render:
+            check_view(serve::parse_request(text, limits), limits);
+            return;
         case MessageKind::Screenshot:
         case MessageKind::Session: {
             const MessageKind k = serve::message_kind(text, limits);
@@ -58,7 +61,9 @@ void answer(const std::string& text, const serve::Limits& limits) {
                        "slice request within its ranges");
             return;
         }
-        case MessageKind::Probe: (void)serve::parse_probe_request(text, limits); return;
+        case MessageKind::Probe:
+            (void)serve::parse_probe_request(text, limits);
+            return;
         case MessageKind::TfExport: {
             const serve::TfExportRequest r = serve::parse_tf_export_request(text, limits);
             (void)discretise(r.tf, ValueRange{0.f, 255.f});

@@ -16,8 +16,9 @@
 namespace lacuna::cli {
 
 void add_volume_args(CLI::App& cmd, VolumeArgs& a, bool required) {
-    auto* opt = cmd.add_option("volume", a.path,
-                               "Volume file (.nii .nii.gz .hdr/.img .nrrd .nhdr .mha .mhd .raw) or DICOM folder");
+    auto* opt = cmd.add_option(
+        "volume", a.path,
+        "Volume file (.nii .nii.gz .hdr/.img .nrrd .nhdr .mha .mhd .raw) or DICOM folder");
     if (required) opt->required();
     cmd.add_option("--dims", a.raw_dims, "Raw files: dimensions, e.g. 301x370x316");
     cmd.add_option("--type", a.raw_type, "Raw files: voxel type (uint8, int16, uint16, float32)");
@@ -53,11 +54,22 @@ uint64_t parse_bytes(const std::string& s, const std::string& where) {
     }
     std::string unit = s.substr(used);
     if (!unit.empty() && unit.front() == ' ') unit.erase(0, 1);
-    static const std::pair<const char*, double> kUnits[] = {
-        {"", 1},       {"B", 1},      {"k", 1e3},    {"K", 1e3},          {"kB", 1e3},
-        {"KB", 1e3},   {"M", 1e6},    {"MB", 1e6},   {"G", 1e9},          {"GB", 1e9},
-        {"T", 1e12},   {"TB", 1e12},  {"KiB", 1024}, {"MiB", 1048576.0}, {"GiB", 1073741824.0},
-        {"TiB", 1099511627776.0}};
+    static const std::pair<const char*, double> kUnits[] = {{"", 1},
+                                                            {"B", 1},
+                                                            {"k", 1e3},
+                                                            {"K", 1e3},
+                                                            {"kB", 1e3},
+                                                            {"KB", 1e3},
+                                                            {"M", 1e6},
+                                                            {"MB", 1e6},
+                                                            {"G", 1e9},
+                                                            {"GB", 1e9},
+                                                            {"T", 1e12},
+                                                            {"TB", 1e12},
+                                                            {"KiB", 1024},
+                                                            {"MiB", 1048576.0},
+                                                            {"GiB", 1073741824.0},
+                                                            {"TiB", 1099511627776.0}};
     for (const auto& [name, scale] : kUnits) {
         if (unit != name) continue;
         const double bytes = x * scale;
@@ -87,7 +99,8 @@ Vec3d parse_spacing(const std::string& s, const std::string& where) {
         sp[n++] = x;
     }
     if (n != 3)
-        throw Error(where, "spacing", "expected three positive numbers X,Y,Z in mm, e.g. 0.5,0.5,1, got '" + s + "'");
+        throw Error(where, "spacing",
+                    "expected three positive numbers X,Y,Z in mm, e.g. 0.5,0.5,1, got '" + s + "'");
     return sp;
 }
 
@@ -113,7 +126,8 @@ Vec3i parse_dims(const std::string& s, const std::string& where) {
 
 ValueRange parse_range(const std::string& range) {
     const size_t c = range.find(':');
-    if (c == std::string::npos) throw Error("--range", "range", "expected MIN:MAX, got '" + range + "'");
+    if (c == std::string::npos)
+        throw Error("--range", "range", "expected MIN:MAX, got '" + range + "'");
     try {
         size_t used = 0;
         const float lo = std::stof(range.substr(0, c), &used);
@@ -132,7 +146,8 @@ std::optional<RawSpec> raw_spec_of(const VolumeArgs& a) {
     if (!a.raw_dims.empty() || !a.raw_type.empty()) {
         RawSpec spec;
         if (a.raw_dims.empty() || a.raw_type.empty())
-            throw Error("--dims/--type", "raw layout", "give both --dims and --type for a raw file");
+            throw Error("--dims/--type", "raw layout",
+                        "give both --dims and --type for a raw file");
         spec.dims = parse_dims(a.raw_dims, "--dims");
         spec.type = parse_voxel_type(a.raw_type, "--type");
         raw = spec;
@@ -196,18 +211,27 @@ std::string plural(int64_t n, const std::string& unit) {
 }
 }  // namespace
 
-void set_quiet(bool q) { g_quiet = q; }
-bool quiet() { return g_quiet; }
+void set_quiet(bool q) {
+    g_quiet = q;
+}
+bool quiet() {
+    return g_quiet;
+}
 
 Progress::Progress(std::string what)
-    : m_what(std::move(what)), m_tty(::isatty(2) && !g_quiet),
-      m_start(std::chrono::steady_clock::now()), m_last_draw(m_start) {
+    : m_what(std::move(what)),
+      m_tty(::isatty(2) && !g_quiet),
+      m_start(std::chrono::steady_clock::now()),
+      m_last_draw(m_start) {
     draw(m_what + " ...", true);
 }
 
 Progress::Progress(std::string what, int64_t total, std::string unit)
-    : m_what(std::move(what)), m_unit(std::move(unit)), m_total(std::max<int64_t>(total, 0)),
-      m_tty(::isatty(2) && !g_quiet), m_start(std::chrono::steady_clock::now()),
+    : m_what(std::move(what)),
+      m_unit(std::move(unit)),
+      m_total(std::max<int64_t>(total, 0)),
+      m_tty(::isatty(2) && !g_quiet),
+      m_start(std::chrono::steady_clock::now()),
       m_last_draw(m_start) {}
 
 // A terminal line, redrawn at most ten times a second unless `force`; padded so a shorter line

@@ -1,7 +1,6 @@
 // Shared pieces of the lacuna CLI: the only place strings become typed options (STYLE.md 3).
 #pragma once
 #include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -16,13 +15,13 @@ namespace lacuna::cli {
 // Options shared by every command that loads a volume.
 struct VolumeArgs {
     std::string path;
-    std::string raw_dims;  // "301x370x316"
-    std::string raw_type;  // "uint8"
-    std::string range;     // "MIN:MAX" visualization range override
+    std::string raw_dims;    // "301x370x316"
+    std::string raw_type;    // "uint8"
+    std::string range;       // "MIN:MAX" visualization range override
     std::string max_memory;  // "12G", "512MB", "1.5GiB", bytes; empty: the default budget
     bool allow_external_data = false;
-    std::optional<int64_t> frame;  // --frame: the volume of a 4D NIfTI file
-    std::string spacing;           // --spacing X,Y,Z for .raw files (mm)
+    std::optional<int64_t> frame;           // --frame: the volume of a 4D NIfTI file
+    std::string spacing;                    // --spacing X,Y,Z for .raw files (mm)
     std::string rgb_opacity = "luminance";  // --rgb-opacity: RGB files' opacity scalar
     // Typed values a session file gives (render --session), used instead of the strings above.
     std::optional<RawSpec> raw_spec;
@@ -44,7 +43,8 @@ uint64_t parse_bytes(const std::string& s, const std::string& where);
 
 // Parses "AxBxC" into dims; throws lacuna::Error(where, "dims", ...).
 Vec3i parse_dims(const std::string& s, const std::string& where);
-// Parses "X,Y,Z" (positive, finite, mm) into a spacing; throws lacuna::Error(where, "spacing", ...).
+// Parses "X,Y,Z" (positive, finite, mm) into a spacing; throws lacuna::Error(where, "spacing",
+// ...).
 Vec3d parse_spacing(const std::string& s, const std::string& where);
 
 // Fails early (before any work) if `path` cannot be created: its folder must exist and be
@@ -71,7 +71,7 @@ void set_quiet(bool quiet);
 bool quiet();
 
 class Progress {
-public:
+  public:
     // A step measured by a fraction (loading a file, building a structure): the terminal only.
     explicit Progress(std::string what);
     // A command's summary over `total` items called `unit` (singular: "frame"); total 0 counts
@@ -84,7 +84,7 @@ public:
     Progress(const Progress&) = delete;
     Progress& operator=(const Progress&) = delete;
 
-private:
+  private:
     void draw(const std::string& line, bool force);
     std::string m_what, m_unit;
     int64_t m_total = -1;  // -1: a fraction, no summary

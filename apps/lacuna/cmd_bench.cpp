@@ -258,9 +258,10 @@ void register_bench(CLI::App& app) {
                   "Comma-separated rows: marching, early-exit, shading (+ PBR shading), lighting "
                   "(+ spotlight with shadow rays)")
         ->capture_default_str();
-    f->add_option("--interpolation", a->interpolation,
-                  "Sampling of every row: trilinear, or nearest (structures built for it; the ideal "
-                  "counts samples whose voxel is visible)")
+    f->add_option(
+         "--interpolation", a->interpolation,
+         "Sampling of every row: trilinear, or nearest (structures built for it; the ideal "
+         "counts samples whose voxel is visible)")
         ->capture_default_str();
     f->add_option("--shadow-step", a->shadow_step, "Shadow-ray sample distance of the lighting row")
         ->capture_default_str();

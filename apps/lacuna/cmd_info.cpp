@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "cli_common.h"
-#include "lacuna/rgb.h"
 #include "lacuna/orientation.h"
+#include "lacuna/rgb.h"
 
 namespace lacuna::cli {
 
@@ -17,15 +17,14 @@ void run(const VolumeArgs& args) {
     const Volume v = load_volume(args);
     const Vec3i d = v.dims();
     std::printf("file:        %s\n", args.path.c_str());
-    std::printf("dims:        %d x %d x %d (%zu voxels, %.1f MiB)\n", d.x, d.y, d.z, v.voxel_count(),
-                double(v.bytes()) / (1 << 20));
+    std::printf("dims:        %d x %d x %d (%zu voxels, %.1f MiB)\n", d.x, d.y, d.z,
+                v.voxel_count(), double(v.bytes()) / (1 << 20));
     std::printf("type:        %s\n", to_string(v.type()).c_str());
     if (const RgbColours* rgb = rgb_colours(v))
-        std::printf("channels:    %s (colour from the data; opacity scalar: %s, %s)\n",
-                    rgb->channels == 4 ? "RGBA (RGBA32)" : "RGB (RGB24)",
-                    to_string(rgb->opacity).c_str(),
-                    rgb->opacity == RgbOpacity::Luminance ? "Rec. 709 float32"
-                                                            : "the channel, uint8");
+        std::printf(
+            "channels:    %s (colour from the data; opacity scalar: %s, %s)\n",
+            rgb->channels == 4 ? "RGBA (RGBA32)" : "RGB (RGB24)", to_string(rgb->opacity).c_str(),
+            rgb->opacity == RgbOpacity::Luminance ? "Rec. 709 float32" : "the channel, uint8");
     std::printf("spacing:     %g x %g x %g mm\n", v.spacing.x, v.spacing.y, v.spacing.z);
     // World frame (docs/formats.md): patient RAS mm; origin and direction also in ITK's LPS.
     const Affine a = index_to_world(v);
@@ -48,8 +47,8 @@ void run(const VolumeArgs& args) {
     std::printf("value range: %g .. %g\n", r.min, r.max);
     std::printf("vis range:   %g .. %g\n", vr.min, vr.max);
     if (v.nan_voxels)
-        std::printf("NaN voxels:  %zu (%.2f%%), read as the minimum %g (background)\n", v.nan_voxels,
-                    100.0 * double(v.nan_voxels) / double(v.voxel_count()), r.min);
+        std::printf("NaN voxels:  %zu (%.2f%%), read as the minimum %g (background)\n",
+                    v.nan_voxels, 100.0 * double(v.nan_voxels) / double(v.voxel_count()), r.min);
 
     // 16-bin histogram over the data range, plus the share of voxels at the minimum (background).
     // In double, as the viewer's histogram: voxels are finite (Volume::compute_range) and the

@@ -12,17 +12,17 @@
 #include "core/parallel.h"
 #include "feature_args.h"
 #include "frame_flags.h"
+#include "io/io_util.h"
 #include "lacuna/accel.h"
 #include "lacuna/error.h"
 #include "lacuna/frame_spec.h"
 #include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
 #include "movie.h"
-#include "io/io_util.h"
-#include "session/session_file.h"
 #include "render_mpi.h"
 #include "render_slice.h"
 #include "segments_cli.h"
+#include "session/session_file.h"
 
 namespace lacuna::cli {
 
@@ -48,7 +48,7 @@ struct RenderArgs {
     // The TFs a session file holds (instead of resolving --tf / --tf-back).
     std::optional<TransferFunction> tf_value, tf_back_value;
     int repeat = 1;  // --repeat: the same frame this many times (warm frames, median reported)
-    bool no_refine = false;  // --no-refine: frames without the structure's finer per-TF level
+    bool no_refine = false;      // --no-refine: frames without the structure's finer per-TF level
     std::string accel = "auto";  // default_accel() for the ray marcher (docs/cli.md)
     std::string out;
     std::string heatmap;
@@ -85,7 +85,8 @@ std::vector<AccelKind> parse_accels(const std::string& s) {
     size_t pos = 0;
     for (;;) {
         const size_t c = s.find(',', pos);
-        out.push_back(parse_accel(s.substr(pos, c == std::string::npos ? std::string::npos : c - pos)));
+        out.push_back(
+            parse_accel(s.substr(pos, c == std::string::npos ? std::string::npos : c - pos)));
         if (c == std::string::npos) break;
         pos = c + 1;
     }
@@ -106,7 +107,9 @@ std::string frame_path(const std::string& out, int i, int n) {
 
 // The azimuth of orbit frame i of n: the start plus i/n of a turn, in float as the single-frame
 // --azimuth is, so frame i is byte for byte `render --azimuth <that value>`.
-float orbit_azimuth(float start, int i, int n) { return start + 360.f * float(i) / float(n); }
+float orbit_azimuth(float start, int i, int n) {
+    return start + 360.f * float(i) / float(n);
+}
 
 // The frame the flags describe (the strings become a FrameSpec here; its ranges are checked by
 // lacuna::validate, whose fields frame_flags.cpp translates back to flags).
@@ -131,7 +134,8 @@ void check_outputs(const RenderArgs& a) {
     if (a.orbit && a.repeat != 1) throw Error("--repeat", "frames", "not with --orbit");
     if (a.orbit && !a.heatmap.empty()) throw Error("--heatmap", "frames", "not with --orbit");
     if (a.orbit && (a.segments.active() || a.slice.renderer == "slice"))
-        throw Error("--orbit", "renderer", "the ray marcher only (not --renderer slice or segments)");
+        throw Error("--orbit", "renderer",
+                    "the ray marcher only (not --renderer slice or segments)");
     if (!a.movie.empty()) {
         if (!sequence) throw Error("--movie", "frames", "needs --orbit N or --tf-animate A B");
         if (a.accel == "all" || a.accel.find(',') != std::string::npos)
@@ -202,8 +206,10 @@ std::string session_text(const RenderArgs& a, const Setup& s) {
     f.volume.path = fs::absolute(a.volume.path).lexically_normal().string();
     f.volume.frame = a.volume.frame;
     f.volume.raw = a.volume.raw_spec ? a.volume.raw_spec : raw_spec_of(a.volume);
-    if (a.volume.range_value) f.volume.range = a.volume.range_value;
-    else if (!a.volume.range.empty()) f.volume.range = parse_range(a.volume.range);
+    if (a.volume.range_value)
+        f.volume.range = a.volume.range_value;
+    else if (!a.volume.range.empty())
+        f.volume.range = parse_range(a.volume.range);
     f.tf = front_tf(a);
     f.tf_back = back_tf(a, s.spec);
     f.frame = s.spec;
@@ -227,7 +233,8 @@ Setup validate(RenderArgs& a) {
         if (!a.azimuth_given) a.azimuth = kDemoAzimuth;
         if (!a.elevation_given) a.elevation = kDemoElevation;
     }
-    if (a.volume.path.empty()) throw Error("render", "volume", "expected a volume file (or --demo)");
+    if (a.volume.path.empty())
+        throw Error("render", "volume", "expected a volume file (or --demo)");
     const bool labels_alone = a.segments.mode == "labels";
     if (a.tf.empty() && a.tf_animate.empty() && !labels_alone)
         throw Error("render", "--tf", "expected a preset name or a .json file");
@@ -268,7 +275,8 @@ Setup validate(RenderArgs& a) {
     f.slicer.occlusion_threshold = a.slice.occlusion_threshold;
     f.slicer.occlusion_map = a.slice.occlusion_map;
     if (a.segments.active()) {
-        f.segments.mode = parse_segment_mode(a.segments.mode.empty() ? "mask" : a.segments.mode, "--segments");
+        f.segments.mode =
+            parse_segment_mode(a.segments.mode.empty() ? "mask" : a.segments.mode, "--segments");
         f.segments.tint = a.segments.tint;
     }
     s.ao.leaf_cells = a.leaf;
@@ -338,21 +346,26 @@ void render_one(const RenderArgs& a, const Setup& s) {
                 spec.height, a.ortho ? "orthographic" : "perspective", tf.name.c_str(),
                 a.accel.c_str(), resolve_threads(a.threads));
     if (r.structure) print_accel(spec.structure, *r.structure);
-    if (const std::string f = describe(spec.features); !f.empty()) std::printf("features: %s\n", f.c_str());
+    if (const std::string f = describe(spec.features); !f.empty())
+        std::printf("features: %s\n", f.c_str());
     if (r.stats.gradient_volume_bytes)
         std::printf("gradient volume: %.2f MiB, computed in %.1f ms\n",
-                    double(r.stats.gradient_volume_bytes) / (1 << 20), r.stats.gradient_volume_seconds * 1e3);
+                    double(r.stats.gradient_volume_bytes) / (1 << 20),
+                    r.stats.gradient_volume_seconds * 1e3);
     if (r.stats.light_volume_bytes)
         std::printf("light volume: %.2f MiB, computed in %.1f ms (part of the render time)\n",
-                    double(r.stats.light_volume_bytes) / (1 << 20), r.stats.light_volume_seconds * 1e3);
+                    double(r.stats.light_volume_bytes) / (1 << 20),
+                    r.stats.light_volume_seconds * 1e3);
     if (r.stats.shadow_samples)
-        std::printf("shadow samples: %.1f per ray\n", double(r.stats.shadow_samples) / double(std::max<uint64_t>(r.stats.rays, 1)));
+        std::printf("shadow samples: %.1f per ray\n",
+                    double(r.stats.shadow_samples) / double(std::max<uint64_t>(r.stats.rays, 1)));
     if (a.repeat > 1)
         std::printf("%d frames: first %.1f ms, the median of the other %d below\n", a.repeat,
                     first_ms, a.repeat - 1);
-    std::printf("render time %.1f ms, %.1f samples/ray, %.1f Msamples/s (%.1f per thread), CPU %.1f ms\n",
-                r.stats.seconds * 1e3, r.stats.samples_per_ray(), r.stats.msamples_per_second(),
-                r.stats.msamples_per_second() / resolve_threads(a.threads), r.stats.cpu_seconds * 1e3);
+    std::printf(
+        "render time %.1f ms, %.1f samples/ray, %.1f Msamples/s (%.1f per thread), CPU %.1f ms\n",
+        r.stats.seconds * 1e3, r.stats.samples_per_ray(), r.stats.msamples_per_second(),
+        r.stats.msamples_per_second() / resolve_threads(a.threads), r.stats.cpu_seconds * 1e3);
     std::printf("wrote %s\n", a.out.c_str());
     std::fflush(stdout);
     summary.done();
@@ -387,16 +400,18 @@ void render_orbit(const RenderArgs& a, const Setup& s) {
         progress.step(i + 1);
     }
     if (movie) movie->finish();
-    std::printf("%s: orbit of %d frames from azimuth %g at elevation %g, %dx%d, tf %s, accel %s, "
-                "%d threads\n",
-                a.volume.path.c_str(), a.orbit, a.azimuth, a.elevation, spec.width, spec.height,
-                tf.name.c_str(), a.accel.c_str(), resolve_threads(a.threads));
+    std::printf(
+        "%s: orbit of %d frames from azimuth %g at elevation %g, %dx%d, tf %s, accel %s, "
+        "%d threads\n",
+        a.volume.path.c_str(), a.orbit, a.azimuth, a.elevation, spec.width, spec.height,
+        tf.name.c_str(), a.accel.c_str(), resolve_threads(a.threads));
     std::printf("frame time %.1f ms (mean), %.1f samples/ray\n", frame_sum / a.orbit * 1e3,
                 spr_sum / a.orbit);
     if (!a.out.empty())
         std::printf("wrote %s .. %s\n", frame_path(a.out, 0, a.orbit).c_str(),
                     frame_path(a.out, a.orbit - 1, a.orbit).c_str());
-    if (movie) std::printf("wrote %s (%d frames at %d fps)\n", a.movie.c_str(), movie->frames(), a.fps);
+    if (movie)
+        std::printf("wrote %s (%d frames at %d fps)\n", a.movie.c_str(), movie->frames(), a.fps);
     std::fflush(stdout);
     progress.done();
 }
@@ -415,9 +430,9 @@ void render_animation(const RenderArgs& a, const Setup& s) {
     if (!a.movie.empty()) movie.emplace(a.movie, s.spec.width, s.spec.height, a.fps);
     Progress progress("render", int64_t(kinds.size()) * a.frames, "frame");
     int64_t frames_done = 0;
-    std::printf("%s: TF animation %s -> %s, %d frames at %dx%d, %d threads\n", a.volume.path.c_str(),
-                tf_a.name.c_str(), tf_b.name.c_str(), a.frames, s.spec.width, s.spec.height,
-                resolve_threads(a.threads));
+    std::printf("%s: TF animation %s -> %s, %d frames at %dx%d, %d threads\n",
+                a.volume.path.c_str(), tf_a.name.c_str(), tf_b.name.c_str(), a.frames, s.spec.width,
+                s.spec.height, resolve_threads(a.threads));
     std::printf("%-10s %12s %16s %16s %14s %12s\n", "accel", "build [ms]", "TF change [ms]",
                 "TF change max", "frame [ms]", "samples/ray");
     for (AccelKind k : kinds) {
@@ -454,7 +469,8 @@ void render_animation(const RenderArgs& a, const Setup& s) {
     if (write_frames)
         std::printf("wrote %s .. %s\n", frame_path(a.out, 0, a.frames).c_str(),
                     frame_path(a.out, a.frames - 1, a.frames).c_str());
-    if (movie) std::printf("wrote %s (%d frames at %d fps)\n", a.movie.c_str(), movie->frames(), a.fps);
+    if (movie)
+        std::printf("wrote %s (%d frames at %d fps)\n", a.movie.c_str(), movie->frames(), a.fps);
     std::fflush(stdout);
     progress.done();
 }
@@ -468,7 +484,8 @@ void render_frames(RenderArgs& a, const Setup& s) {
                               : s.spec.renderer == Renderer::Slicer   ? "none"
                                                                       : a.accel;
     if (mpi_render_active() && s.spec.renderer != Renderer::RayMarcher)
-        throw Error("mpirun", "renderer", "the ray marcher only (not --renderer slice or segments)");
+        throw Error("mpirun", "renderer",
+                    "the ray marcher only (not --renderer slice or segments)");
     switch (s.spec.renderer) {
         case Renderer::Segments: {
             Progress summary("render", 1, "frame");
@@ -492,7 +509,8 @@ void render_frames(RenderArgs& a, const Setup& s) {
                     throw Error("mpirun", "frames",
                                 "one frame per run under mpirun (not --orbit, --tf-animate, "
                                 "--repeat or --movie yet)");
-                render_mpi({a.volume, front_tf(a), accel, a.out, a.heatmap, a.threads, s.spec, a.mpi});
+                render_mpi(
+                    {a.volume, front_tf(a), accel, a.out, a.heatmap, a.threads, s.spec, a.mpi});
                 return;
             }
             if (a.orbit)
@@ -523,7 +541,8 @@ void register_render(CLI::App& app) {
     auto a = std::make_shared<RenderArgs>();
     auto* cmd = app.add_subcommand("render", "Render a volume to a PNG");
     add_volume_args(*cmd, a->volume, false);
-    cmd->add_flag("--demo", a->demo, "Render the default real dataset (mricron ch2better brain, mr-brain)");
+    cmd->add_flag("--demo", a->demo,
+                  "Render the default real dataset (mricron ch2better brain, mr-brain)");
     cmd->add_option("--tf", a->tf, "Transfer function: a preset name or a .json file");
     cmd->add_option("--tf-animate", a->tf_animate,
                     "Two TFs A B: render --frames frames interpolating from A to B and report "
@@ -557,7 +576,8 @@ void register_render(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--leaf", a->leaf, "Octree leaf edge in cells (2..64, power of two)")
         ->capture_default_str();
-    cmd->add_option("--bits", a->bits, "Bitfield width (8, 16, 32, 64, 128)")->capture_default_str();
+    cmd->add_option("--bits", a->bits, "Bitfield width (8, 16, 32, 64, 128)")
+        ->capture_default_str();
     cmd->add_option("--initial-level", a->initial_level,
                     "Octree level traversal starts at (-1 = root)")
         ->capture_default_str();
@@ -585,7 +605,8 @@ void register_render(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--ert", a->ert, "Early ray termination opacity (1 turns it off)")
         ->capture_default_str();
-    cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
+    cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
+        ->capture_default_str();
     cmd->add_option("--background", a->background, "Background colour R,G,B in [0,1]")
         ->capture_default_str();
     add_feature_args(*cmd, a->features);
@@ -602,9 +623,9 @@ void register_render(CLI::App& app) {
         a->elevation_given = cmd->count("--elevation") > 0;
         if (!a->session.empty()) {
             // The file is the frame: a flag that would change it is refused, not ignored.
-            static const char* const kAllowed[] = {"--session", "--out", "--threads", "--orbit",
-                                                   "--movie",   "--fps", "--quiet",   "--save-session",
-                                                   "--max-memory", "--no-refine", "--repeat"};
+            static const char* const kAllowed[] = {
+                "--session", "--out",          "--threads",    "--orbit",     "--movie", "--fps",
+                "--quiet",   "--save-session", "--max-memory", "--no-refine", "--repeat"};
             for (const CLI::Option* o : cmd->get_options()) {
                 if (o->count() == 0) continue;
                 bool ok = false;

@@ -4,9 +4,9 @@
 #include <filesystem>
 
 #include "cli_common.h"
-#include "lacuna/volume_frames.h"
 #include "lacuna/error.h"
 #include "lacuna/transfer_function.h"
+#include "lacuna/volume_frames.h"
 #include "serve/frame_renderer.h"
 #include "serve/server.h"
 

@@ -62,13 +62,14 @@ void render_segments(const SegmentArgs& a, const SegmentFrame& f) {
     int shown = 0;
     for (const auto& s : table.styles) shown += s.visible && s.opacity > 0.f;
     std::printf("%s: %dx%d, segments %s, %d of %d labels visible, accel %s, %d threads\n",
-                f.volume.path.c_str(), spec.width, spec.height, to_string(spec.segments.mode).c_str(),
-                shown, table.size(), octree ? "label bitfield octree" : f.accel.c_str(),
-                resolve_threads(f.threads));
+                f.volume.path.c_str(), spec.width, spec.height,
+                to_string(spec.segments.mode).c_str(), shown, table.size(),
+                octree ? "label bitfield octree" : f.accel.c_str(), resolve_threads(f.threads));
     if (octree)
-        std::printf("label octree: build %.1f ms, %d bits per node, %.2f MiB, label change %.3f ms\n",
-                    r.segments->build_seconds * 1e3, 64 * r.segments->label_words,
-                    double(r.segments->bytes) / (1 << 20), r.segments->label_update_seconds * 1e3);
+        std::printf(
+            "label octree: build %.1f ms, %d bits per node, %.2f MiB, label change %.3f ms\n",
+            r.segments->build_seconds * 1e3, 64 * r.segments->label_words,
+            double(r.segments->bytes) / (1 << 20), r.segments->label_update_seconds * 1e3);
     std::printf("render time %.1f ms, %.1f samples/ray\n", r.stats.seconds * 1e3,
                 r.stats.samples_per_ray());
     std::printf("wrote %s\n", f.out.c_str());

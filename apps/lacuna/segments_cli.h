@@ -2,7 +2,6 @@
 // from cmd_render.cpp so the render command only forwards to it.
 #pragma once
 #include <CLI/CLI.hpp>
-
 #include <optional>
 #include <string>
 
@@ -13,9 +12,9 @@
 namespace lacuna::cli {
 
 struct SegmentArgs {
-    std::string labels;       // label volume (mask mode); empty with --segments labels: the volume
-    std::string mode;         // "mask" | "labels" (default: mask when --labels is given)
-    std::string style;        // .json label table or MRIcron .lut
+    std::string labels;  // label volume (mask mode); empty with --segments labels: the volume
+    std::string mode;    // "mask" | "labels" (default: mask when --labels is given)
+    std::string style;   // .json label table or MRIcron .lut
     std::vector<std::string> show, hide;  // applied in order: show then hide
     float tint = 0.f;
     bool active() const { return !labels.empty() || !mode.empty(); }
@@ -31,7 +30,8 @@ struct SegmentFrame {
     int threads = 0;
     FrameSpec spec;
     std::string out, heatmap;
-    std::optional<TransferFunction> tf_value;  // the TF itself (a session file's), else `tf` resolved
+    std::optional<TransferFunction>
+        tf_value;  // the TF itself (a session file's), else `tf` resolved
 };
 void render_segments(const SegmentArgs& a, const SegmentFrame& f);
 

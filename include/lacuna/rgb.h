@@ -30,7 +30,7 @@ std::string to_string(RgbOpacity o);
 RgbOpacity parse_rgb_opacity(const std::string& name, const std::string& where = "--rgb-opacity");
 
 struct RgbColours {
-    int channels = 3;  // in the file: 3 (RGB24) or 4 (RGBA32)
+    int channels = 3;                            // in the file: 3 (RGB24) or 4 (RGBA32)
     RgbOpacity opacity = RgbOpacity::Luminance;  // what the volume's scalar voxels hold
     std::vector<uint8_t> rgba;  // 4 bytes per voxel (a = 255 without alpha), x fastest
 };

@@ -210,18 +210,20 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
                     return int(w);
                 };
 #define LACUNA_PAIRS(l)                                    \
-    {                                                      \
+    do {                                                   \
         const T* p = data + ofs[l];                        \
         v01 = _mm_insert_epi16(v01, pair(p), l);           \
         v01 = _mm_insert_epi16(v01, pair(p + sy), 4 + l);  \
         v23 = _mm_insert_epi16(v23, pair(p + sz), l);      \
         v23 = _mm_insert_epi16(v23, pair(p + syz), 4 + l); \
-    }
-                LACUNA_PAIRS(0)
-                LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+    } while (0)
+                LACUNA_PAIRS(0);
+                LACUNA_PAIRS(1);
+                LACUNA_PAIRS(2);
+                LACUNA_PAIRS(3);
 #undef LACUNA_PAIRS
-                    const __m128i m_lo0 =
-                        _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
+                const __m128i m_lo0 =
+                    _mm_setr_epi8(0, -1, -1, -1, 2, -1, -1, -1, 4, -1, -1, -1, 6, -1, -1, -1);
                 const __m128i m_hi0 =
                     _mm_setr_epi8(1, -1, -1, -1, 3, -1, -1, -1, 5, -1, -1, -1, 7, -1, -1, -1);
                 const __m128i m_lo1 =
@@ -245,17 +247,19 @@ inline void march_lanes4(Lanes& s, const LaneGrid& g, const T* data, const float
                     return w;
                 };
 #define LACUNA_PAIRS(l)                                  \
-    {                                                    \
+    do {                                                 \
         const T* p = data + ofs[l];                      \
         v[0] = _mm_insert_epi32(v[0], pair(p), l);       \
         v[1] = _mm_insert_epi32(v[1], pair(p + sy), l);  \
         v[2] = _mm_insert_epi32(v[2], pair(p + sz), l);  \
         v[3] = _mm_insert_epi32(v[3], pair(p + syz), l); \
-    }
-                LACUNA_PAIRS(0)
-                LACUNA_PAIRS(1) LACUNA_PAIRS(2) LACUNA_PAIRS(3)
+    } while (0)
+                LACUNA_PAIRS(0);
+                LACUNA_PAIRS(1);
+                LACUNA_PAIRS(2);
+                LACUNA_PAIRS(3);
 #undef LACUNA_PAIRS
-                    for (int q = 0; q < 4; ++q) {
+                for (int q = 0; q < 4; ++q) {
                     if constexpr (std::is_signed_v<T>) {
                         lo[q] = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(v[q], 16), 16));
                         hi[q] = _mm_cvtepi32_ps(_mm_srai_epi32(v[q], 16));

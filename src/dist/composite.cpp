@@ -125,10 +125,11 @@ Partial composite_direct(Comm& comm, const Partial& mine, const std::vector<int>
 // sends its non-empty rectangle to rank s, which composites it in its pair's visibility order
 // (child 0, the low side, is rank s). True on the ranks that sent: they are done.
 static bool fold_extras(Comm& comm, Partial& mine, const Decomposition& d, Vec3f eye, Vec3f dir,
-                 bool orthographic, CompositeStats& st) {
+                        bool orthographic, CompositeStats& st) {
     const int rank = comm.rank(), p = swap_ranks(comm.size()), extras = comm.size() - p;
     if (rank >= p) {
-        send_rect(comm, rank - p, kTagFold, mine, nonempty_rect(mine, Rect{0, 0, mine.width, mine.height}), st);
+        send_rect(comm, rank - p, kTagFold, mine,
+                  nonempty_rect(mine, Rect{0, 0, mine.width, mine.height}), st);
         return true;
     }
     if (rank < extras) {

@@ -29,9 +29,9 @@
 
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include "io/io_util.h"
@@ -142,10 +142,11 @@ NiftiHeader parse_header(gzFile f, const std::string& path, bool pair) {
                         "the header says its voxels are in a separate .img file (magic 'ni1'): "
                         "name it .hdr beside its .img");
         if (std::memcmp(magic, pair ? "ni1\0" : "n+1\0", 4) != 0)
-            throw Error(path, "header",
-                        pair ? "not a NIfTI-1 pair header (magic 'ni1' missing; Analyze 7.5 headers "
-                               "are not read: their orientation is not in the file)"
-                             : "not a NIfTI-1 file (magic 'n+1' missing; Analyze 7.5 is not supported)");
+            throw Error(
+                path, "header",
+                pair ? "not a NIfTI-1 pair header (magic 'ni1' missing; Analyze 7.5 headers "
+                       "are not read: their orientation is not in the file)"
+                     : "not a NIfTI-1 file (magic 'n+1' missing; Analyze 7.5 is not supported)");
         for (int i = 0; i < 8; ++i) h.dim[i] = get<int16_t>(buf, 40 + 2 * i, s);
         h.datatype = get<int16_t>(buf, 70, s);
         h.bitpix = get<int16_t>(buf, 72, s);
@@ -506,7 +507,8 @@ struct NiftiFiles {
 };
 NiftiFiles nifti_files(const std::string& path) {
     const std::string ext = format_extension(path);
-    if (ext != ".hdr" && ext != ".img" && ext != ".img.gz" && ext != ".hdr.gz") return {path, path, false};
+    if (ext != ".hdr" && ext != ".img" && ext != ".img.gz" && ext != ".hdr.gz")
+        return {path, path, false};
     const std::string stem = path.substr(0, path.size() - ext.size());
     auto first = [&](std::initializer_list<const char*> exts) {
         for (const char* e : exts)
@@ -548,20 +550,23 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity r
     // NIfTI: slope 0 (or non-finite) means "no scaling"; scaled data is float, as in ITK.
     const bool rescale = !channels && std::isfinite(h.slope) && std::isfinite(h.inter) &&
                          h.slope != 0.0 && (h.slope != 1.0 || h.inter != 0.0);
-    const VoxelType type = channels ? rgb_scalar_type(rgb_opacity)
-                                    : rescale ? VoxelType::Float32 : stored_type(disk);
+    const VoxelType type = channels  ? rgb_scalar_type(rgb_opacity)
+                           : rescale ? VoxelType::Float32
+                                     : stored_type(disk);
     // dims are 2..kMaxDim each, so these products fit; sat_add guards a wild vox_offset. The
     // chosen volume starts `frame` volumes after vox_offset (frames are stored one after another).
     const uint64_t data_bytes = grid_bytes(dims, channels ? channels : disk_type_size(disk));
     const uint64_t offset = sat_add(uint64_t(h.vox_offset), sat_mul(uint64_t(frame), data_bytes));
     if (channels && header_only)
-        throw Error(path, "datatype", "RGB volumes are read whole, not by brick (distributed frames)");
+        throw Error(path, "datatype",
+                    "RGB volumes are read whole, not by brick (distributed frames)");
     if (!header_only)
-        check_budget(path, "dims",
-                     dims_string(dims) + " " +
-                         (channels ? std::string(channels == 3 ? "RGB24" : "RGBA32") : to_string(type)),
-                     grid_bytes(dims, channels ? rgb_bytes_per_voxel(rgb_opacity) : voxel_size(type)),
-                     opts.max_memory);
+        check_budget(
+            path, "dims",
+            dims_string(dims) + " " +
+                (channels ? std::string(channels == 3 ? "RGB24" : "RGBA32") : to_string(type)),
+            grid_bytes(dims, channels ? rgb_bytes_per_voxel(rgb_opacity) : voxel_size(type)),
+            opts.max_memory);
 
     // An uncompressed file's length is known: report truncation before allocating. A
     // compressed one is inflated incrementally into the buffer, whose pages are only touched
@@ -584,17 +589,18 @@ Volume read_nifti(const std::string& path, const ReadOptions& opts, RgbOpacity r
     set_geometry(h, v, path);
     check_geometry(v, path);  // before the voxels are read
     if (header_only) {
-        *header_only = {data_path, offset, disk, h.swap, gzdirect(f) != 0, rescale, h.slope,
-                        h.inter};
+        *header_only = {data_path,        offset,  disk,    h.swap,
+                        gzdirect(f) != 0, rescale, h.slope, h.inter};
         return v;
     }
     // (a compressed file is inflated up to the offset; gzseek says -1 if the stream ends first)
     if (offset > uint64_t(std::numeric_limits<z_off_t>::max()) ||
         gzseek(f, z_off_t(offset), SEEK_SET) != z_off_t(offset))
-        throw Error(data_path, "voxel data",
-                    frame ? "truncated: the file ends before volume " + std::to_string(frame) +
-                                " at offset " + std::to_string(offset)
-                          : "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
+        throw Error(
+            data_path, "voxel data",
+            frame ? "truncated: the file ends before volume " + std::to_string(frame) +
+                        " at offset " + std::to_string(offset)
+                  : "truncated: the file ends before vox_offset " + std::to_string(h.vox_offset));
     const auto read = [&](void* buf, size_t n) { return gz_read_all(f, buf, n, data_path); };
     if (channels)  // bytes: no byte order to swap
         read_rgb_stream(read, v, data_path, opts.progress);

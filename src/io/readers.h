@@ -30,7 +30,8 @@ struct VoxelLayout {
 // RGB24/RGBA32 files: their opacity scalar is `rgb_opacity` (lacuna/rgb.h); `header_only`:
 // VoxelLayout's contract (RGB files are not read by brick: an error).
 Volume read_nifti(const std::string& path, const ReadOptions& opts,
-                  RgbOpacity rgb_opacity = RgbOpacity::Luminance, VoxelLayout* header_only = nullptr);
+                  RgbOpacity rgb_opacity = RgbOpacity::Luminance,
+                  VoxelLayout* header_only = nullptr);
 // The volumes of a NIfTI file along dim[4] (1 for a 3D file), from its header alone.
 int64_t nifti_frames(const std::string& path);
 // NRRD (.nrrd/.nhdr), MetaImage (.mha/.mhd) and anything else ITK recognises.

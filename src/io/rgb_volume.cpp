@@ -15,23 +15,30 @@ namespace lacuna {
 
 std::string to_string(RgbOpacity o) {
     switch (o) {
-        case RgbOpacity::Luminance: return "luminance";
-        case RgbOpacity::R: return "r";
-        case RgbOpacity::G: return "g";
-        case RgbOpacity::B: return "b";
-        case RgbOpacity::A: return "a";
+        case RgbOpacity::Luminance:
+            return "luminance";
+        case RgbOpacity::R:
+            return "r";
+        case RgbOpacity::G:
+            return "g";
+        case RgbOpacity::B:
+            return "b";
+        case RgbOpacity::A:
+            return "a";
     }
     return "?";
 }
 
 RgbOpacity parse_rgb_opacity(const std::string& name, const std::string& where) {
     static const std::pair<const char*, RgbOpacity> kNames[] = {
-        {"luminance", RgbOpacity::Luminance}, {"r", RgbOpacity::R}, {"g", RgbOpacity::G},
-        {"b", RgbOpacity::B}, {"a", RgbOpacity::A}};
+        {"luminance", RgbOpacity::Luminance},
+        {"r", RgbOpacity::R},
+        {"g", RgbOpacity::G},
+        {"b", RgbOpacity::B},
+        {"a", RgbOpacity::A}};
     for (const auto& [n, o] : kNames)
         if (name == n) return o;
-    throw Error(where, "rgb opacity",
-                "expected one of: luminance, r, g, b, a; got '" + name + "'");
+    throw Error(where, "rgb opacity", "expected one of: luminance, r, g, b, a; got '" + name + "'");
 }
 
 namespace {
@@ -82,7 +89,9 @@ RgbColours* find_colours(const Volume& v) {
 
 }  // namespace
 
-const RgbColours* rgb_colours(const Volume& v) { return find_colours(v); }
+const RgbColours* rgb_colours(const Volume& v) {
+    return find_colours(v);
+}
 
 }  // namespace lacuna
 
@@ -92,7 +101,9 @@ VoxelType rgb_scalar_type(RgbOpacity o) {
     return o == RgbOpacity::Luminance ? VoxelType::Float32 : VoxelType::UInt8;
 }
 
-uint64_t rgb_bytes_per_voxel(RgbOpacity o) { return 4 + voxel_size(rgb_scalar_type(o)); }
+uint64_t rgb_bytes_per_voxel(RgbOpacity o) {
+    return 4 + voxel_size(rgb_scalar_type(o));
+}
 
 void check_rgb_opacity(int channels, RgbOpacity o, const std::string& path) {
     if (o == RgbOpacity::A && channels < 4)
@@ -106,7 +117,8 @@ Volume rgb_volume(Vec3i dims, int channels, RgbOpacity o, const std::string& whe
     auto owner = std::make_shared<RgbOwner>();
     // calloc: fresh pages, touched only as data arrives (as Volume's own constructor does).
     owner->data = std::calloc(count, voxel_size(type));
-    if (!owner->data) throw Error(where, "memory", "out of memory for " + dims_string(dims) + " voxels");
+    if (!owner->data)
+        throw Error(where, "memory", "out of memory for " + dims_string(dims) + " voxels");
     owner->dims = dims;
     owner->type = type;
     owner->colours.channels = channels;
@@ -142,8 +154,8 @@ void read_rgb_stream(const std::function<size_t(void*, size_t)>& read, Volume& v
         if (got < n * nc)
             throw Error(where, "voxel data",
                         "truncated: expected " + std::to_string(count * nc) + " bytes of " +
-                            (channels == 3 ? "RGB24" : "RGBA32") +
-                            " voxels, the data ends after " + std::to_string(first * nc + got));
+                            (channels == 3 ? "RGB24" : "RGBA32") + " voxels, the data ends after " +
+                            std::to_string(first * nc + got));
         colours->rgba.resize((first + n) * 4);
         uint8_t* dst = colours->rgba.data() + first * 4;
         for (size_t i = 0; i < n; ++i) {

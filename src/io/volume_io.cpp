@@ -23,11 +23,13 @@ Volume read_volume(const std::string& path, const ReadOptions& opts, RgbOpacity 
     try {
         std::error_code ec;
         const std::string e = io::format_extension(path);
-        const bool nifti = e == ".nii" || e == ".nii.gz" || e == ".hdr" || e == ".img" || e == ".img.gz";
+        const bool nifti =
+            e == ".nii" || e == ".nii.gz" || e == ".hdr" || e == ".img" || e == ".img.gz";
         if (opts.frame && *opts.frame != 0 && !nifti)
             throw Error(path, "frame",
                         "expected 0: this format is read as one volume (volumes are chosen in "
-                        "4D NIfTI files), got " + std::to_string(*opts.frame));
+                        "4D NIfTI files), got " +
+                            std::to_string(*opts.frame));
         if (!path.empty() && std::filesystem::is_directory(path, ec)) {
             v = io::read_dicom_dir(path, opts);
         } else {
@@ -40,7 +42,7 @@ Volume read_volume(const std::string& path, const ReadOptions& opts, RgbOpacity 
             else
                 v = io::read_itk(path, opts);
         }
-        check_geometry(v, path);  // one world frame: no zero, singular or sheared axes
+        check_geometry(v, path);           // one world frame: no zero, singular or sheared axes
         v.replace_nan_with_minimum(path);  // NaN is background (docs/formats.md)
         v.compute_range(path);
     } catch (const Error&) {

@@ -1,5 +1,3 @@
-#include "lacuna/renderer.h"
-
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -11,9 +9,10 @@
 #include "core/parallel.h"
 #include "core/simd_lanes.h"
 #include "lacuna/error.h"
+#include "lacuna/renderer.h"
+#include "render/lane_scheduler.h"
 #include "render/marcher_cache.h"
 #include "render/ownership.h"
-#include "render/lane_scheduler.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 #include "render/rgb_march.h"
@@ -23,9 +22,9 @@ namespace lacuna {
 
 std::string to_string(const RenderStats& s) {
     char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "%.1f ms, %llu samples, %.1f samples/ray, %.1f Msamples/s", s.seconds * 1e3,
-                  (unsigned long long)s.samples, s.samples_per_ray(), s.msamples_per_second());
+    std::snprintf(buf, sizeof buf, "%.1f ms, %llu samples, %.1f samples/ray, %.1f Msamples/s",
+                  s.seconds * 1e3, (unsigned long long)s.samples, s.samples_per_ray(),
+                  s.msamples_per_second());
     return buf;
 }
 
@@ -40,7 +39,8 @@ std::vector<Rgba> step_corrected_lut(const TransferLut& lut, float step) {
     return out;
 }
 
-RayMarcher::RayMarcher(const Volume& volume) : m_volume(volume), m_cache(std::make_unique<Cache>()) {}
+RayMarcher::RayMarcher(const Volume& volume)
+    : m_volume(volume), m_cache(std::make_unique<Cache>()) {}
 RayMarcher::~RayMarcher() = default;
 
 void RayMarcher::set_transfer_function(const TransferLut& lut) {
@@ -55,41 +55,50 @@ void RayMarcher::set_back_transfer_function(const TransferLut& lut) {
 
 std::string to_string(ShadingModel m) {
     switch (m) {
-        case ShadingModel::None: return "none";
-        case ShadingModel::Phong: return "phong";
-        case ShadingModel::Pbr: return "pbr";
+        case ShadingModel::None:
+            return "none";
+        case ShadingModel::Phong:
+            return "phong";
+        case ShadingModel::Pbr:
+            return "pbr";
     }
     return "?";
 }
 
 std::string to_string(LightKind k) {
     switch (k) {
-        case LightKind::Head: return "head";
-        case LightKind::Directional: return "directional";
-        case LightKind::Spot: return "spot";
+        case LightKind::Head:
+            return "head";
+        case LightKind::Directional:
+            return "directional";
+        case LightKind::Spot:
+            return "spot";
     }
     return "?";
 }
 
-
 TransferLut union_lut(const TransferLut& a, const TransferLut& b) {
     if (a.size() != b.size() || a.vis.min != b.vis.min || a.vis.max != b.vis.max)
-        throw FrameError("two_tfs", "expected a back TF with the front TF's LUT size and "
-                                    "visualization range");
+        throw FrameError("two_tfs",
+                         "expected a back TF with the front TF's LUT size and "
+                         "visualization range");
     TransferLut u = a;
     for (size_t e = 0; e < u.entries.size(); ++e)
         u.entries[e].a = std::max(a.entries[e].a, b.entries[e].a);
     return u;
 }
 
-Box3f RayMarcher::bounds() const { return world_bounds(m_volume); }
+Box3f RayMarcher::bounds() const {
+    return world_bounds(m_volume);
+}
 
 namespace {
 
 template <class T, class Index, bool kNearest, class S>
-void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam, const RenderOptions& opt,
-                 const std::vector<Rgba>& lut, ValueToLut map, int x0, int y0, int x1, int y1,
-                 RenderResult& out, std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam,
+                 const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map, int x0,
+                 int y0, int x1, int y1, RenderResult& out, std::atomic<uint64_t>& samples,
+                 std::atomic<uint64_t>& rays) {
     const kernel::Grid<T, Index> g = kernel::make_grid<Index>(data, vol.dims());
     const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, opt.step);
@@ -105,8 +114,8 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
                 ++tile_rays;
                 typename S::Cursor cursor(accel, r, t_near, t_far, dt,
                                           opt.ert < 1.f ? kCursorChunk * dt : 0.f);
-                kernel::RayStream<T, Index, kNearest> stream(g, r, t_near, dt, lut.data(), map, opt.ert,
-                                                   acc);
+                kernel::RayStream<T, Index, kNearest> stream(g, r, t_near, dt, lut.data(), map,
+                                                             opt.ert, acc);
                 for_each_lattice_run(cursor, t_near, dt, lattice_end(t_near, t_far, dt),
                                      [&](int kb, int ke) { return stream.add(kb, ke); });
                 stream.finish();
@@ -134,9 +143,10 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
     if (leap) set_leap(lg, *leap);
     CompositePolicy policy{out, opt};
     uint64_t tile_samples = 0, tile_rays = 0;
-    schedule_tile_lanes<W>(accel, vol, cam, dt, opt.ert < 1.f ? kLaneChunk * dt : 0.f, opt.ert,
-                           x0, y0, x1, y1, policy, tile_samples, tile_rays,
-                           [&](simd::Lanes& L, auto& refill) { march(L, lg, data, &lut[0].r, refill); });
+    schedule_tile_lanes<W>(
+        accel, vol, cam, dt, opt.ert < 1.f ? kLaneChunk * dt : 0.f, opt.ert, x0, y0, x1, y1, policy,
+        tile_samples, tile_rays,
+        [&](simd::Lanes& L, auto& refill) { march(L, lg, data, &lut[0].r, refill); });
     samples += tile_samples;
     rays += tile_rays;
 }
@@ -149,12 +159,13 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                     ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
                     std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
     if (rgb_colours(vol)) {  // colour from the data: the one-ray kernel of render/rgb_march.h only
-        render_rgb_tile<T, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays);
+        render_rgb_tile<T, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
+                                     samples, rays);
         return;
     }
     if (!small || (x1 - x0) * (y1 - y0) > kMaxTilePixels) {
         render_tile<T, int64_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                samples, rays);
+                                          samples, rays);
         return;
     }
 #if LACUNA_SIMD_X86
@@ -165,9 +176,10 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
         if (isa == simd::Isa::Avx512 && accel.leap_map()) {
             render_tile_lanes<32>(
                 kWholeRay, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
-                [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l, auto& refill) {
-                    simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true, 2>(
-                        L, lg, d, l, refill);
+                [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l,
+                   auto& refill) {
+                    simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true,
+                                        2>(L, lg, d, l, refill);
                 },
                 &accel);
             return;
@@ -175,7 +187,8 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
         if (isa == simd::Isa::Avx2 && accel.leap_map()) {
             render_tile_lanes<8>(
                 kWholeRay, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
-                [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l, auto& refill) {
+                [](simd::Lanes& L, const simd::LaneGrid& lg, const T* d, const float* l,
+                   auto& refill) {
                     simd::march_lanes8<false, T, std::remove_reference_t<decltype(refill)>, true>(
                         L, lg, d, l, refill);
                 },
@@ -192,21 +205,19 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                                   [](auto&&... a) { simd::march_lanes16<kNearest, T>(a...); });
             return;
         case simd::Isa::Avx2:
-            render_tile_lanes<8>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                 samples, rays,
-                                  [](auto&&... a) { simd::march_lanes8<kNearest, T>(a...); });
+            render_tile_lanes<8>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples,
+                                 rays, [](auto&&... a) { simd::march_lanes8<kNearest, T>(a...); });
             return;
 #if defined(__SSE4_1__)
         case simd::Isa::Sse41:
-            render_tile_lanes<4>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                 samples, rays,
-                                  [](auto&&... a) { simd::march_lanes4<kNearest, T>(a...); });
+            render_tile_lanes<4>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples,
+                                 rays, [](auto&&... a) { simd::march_lanes4<kNearest, T>(a...); });
             return;
 #endif
 #endif
         default:
-            render_tile<T, int32_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                    samples, rays);
+            render_tile<T, int32_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1,
+                                              out, samples, rays);
     }
 }
 
@@ -226,8 +237,10 @@ void render_tile_brick(const S& accel, const Volume& vol, const T* data, const B
     kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, own.whole_dims);
     g.sy = ptrdiff_t(vol.dims().x);
     g.sz = ptrdiff_t(vol.dims().x) * ptrdiff_t(vol.dims().y);
-    const ptrdiff_t shift = ptrdiff_t(own.offset.z) * g.sz + ptrdiff_t(own.offset.y) * g.sy + own.offset.x;
-    g.data = reinterpret_cast<const T*>(reinterpret_cast<uintptr_t>(data) - uintptr_t(shift) * sizeof(T));
+    const ptrdiff_t shift =
+        ptrdiff_t(own.offset.z) * g.sz + ptrdiff_t(own.offset.y) * g.sy + own.offset.x;
+    g.data = reinterpret_cast<const T*>(reinterpret_cast<uintptr_t>(data) -
+                                        uintptr_t(shift) * sizeof(T));
     const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, opt.step);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
@@ -364,8 +377,8 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
                                            render_tile_on<T, decltype(nearest)::value>(
-                                               isa, small, s, m_volume, data, cam, opt, lut, map, x0,
-                                               y0, x1, y1, out, samples, rays);
+                                               isa, small, s, m_volume, data, cam, opt, lut, map,
+                                               x0, y0, x1, y1, out, samples, rays);
                                        });
                 };
                 if (opt.interpolation == Interpolation::Nearest)

@@ -32,9 +32,10 @@ namespace lacuna {
 inline void check_rgb_options(const Volume& vol, const RenderOptions& opt) {
     if (!rgb_colours(vol)) return;
     if (opt.features.any())
-        throw FrameError("features", "no features (shading, clipping, crop, blend modes, jitter) "
-                                     "for an RGB volume: its colour comes from the data (a "
-                                     "shaded preset needs --shading none)");
+        throw FrameError("features",
+                         "no features (shading, clipping, crop, blend modes, jitter) "
+                         "for an RGB volume: its colour comes from the data (a "
+                         "shaded preset needs --shading none)");
     if (opt.brick) throw FrameError("brick", "an RGB volume is not rendered distributed");
 }
 
@@ -77,11 +78,18 @@ inline void sample_rgb(const Grid<T, Index>& g, const uint8_t* rgba, float x, fl
 // one sample at a time.
 template <class T, class Index, bool kNearest>
 class RgbRayStream {
-public:
+  public:
     RgbRayStream(const Grid<T, Index>& g, const uint8_t* rgba, const IndexRay& r, float t_base,
                  float dt, const Rgba* lut, ValueToLut map, float ert, Accum& acc)
-        : m_g(g), m_rgba(rgba), m_r(r), m_t_base(t_base), m_dt(dt), m_lut(lut), m_map(map),
-          m_ert(ert), m_acc(acc) {}
+        : m_g(g),
+          m_rgba(rgba),
+          m_r(r),
+          m_t_base(t_base),
+          m_dt(dt),
+          m_lut(lut),
+          m_map(map),
+          m_ert(ert),
+          m_acc(acc) {}
 
     // Composites the samples [kb, ke); false once the ray is opaque.
     bool add(int kb, int ke) {
@@ -108,7 +116,7 @@ public:
     void finish() {}
     uint32_t samples() const { return m_n; }
 
-private:
+  private:
     const Grid<T, Index>& m_g;
     const uint8_t* m_rgba;
     IndexRay m_r;
@@ -126,9 +134,9 @@ private:
 // One tile of an RGB volume: render_tile's loop (ray_marcher.cpp) with RgbRayStream.
 template <class T, bool kNearest, class S>
 void render_rgb_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam,
-                     const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
-                     int x0, int y0, int x1, int y1, RenderResult& out,
-                     std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+                     const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map, int x0,
+                     int y0, int x1, int y1, RenderResult& out, std::atomic<uint64_t>& samples,
+                     std::atomic<uint64_t>& rays) {
     const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, vol.dims());
     const uint8_t* rgba = rgb_colours(vol)->rgba.data();
     const Vec3f inv_sp = inverse_spacing(vol);

@@ -85,8 +85,8 @@ FrameRenderer::SliceImage FrameRenderer::slice(const SliceRequest& req, int max_
     o.max_size = req.max_size > 0 ? std::min(req.max_size, max_side) : max_side;
     o.threads = m_threads;
     const Volume& v = m_session->volume();
-    const Slice s = sample_slice(v, slice_geometry(v, req.plane, req.point, o), o.interpolation,
-                                 o.threads);
+    const Slice s =
+        sample_slice(v, slice_geometry(v, req.plane, req.point, o), o.interpolation, o.threads);
     SliceImage out;
     out.geometry = s.geometry;
     out.image = window_level(s, req.window, req.level);
@@ -120,7 +120,8 @@ FrameSpec FrameRenderer::frame_spec(const ViewRequest& req, int width, int heigh
     f.sampling.early_termination = req.ert ? std::optional<float>(0.99f) : std::nullopt;
     if (req.shading) f.features.shading = ShadingModel::Phong;
     if (req.clip)
-        f.features.clip_planes.push_back(ClipPlane{{-1.f, 0.f, 0.f}, -m_session->bounds().center().x});
+        f.features.clip_planes.push_back(
+            ClipPlane{{-1.f, 0.f, 0.f}, -m_session->bounds().center().x});
     for (const ClipPlane& p : req.clip_planes) f.features.clip_planes.push_back(p);
     if (segments) {
         LabelTable t = m_session->label_table();
@@ -153,8 +154,8 @@ ViewRequest FrameRenderer::view_request(const FrameSpec& f, const TransferFuncti
     }
     if (!listed)
         throw Error("session", "frame.structure",
-                    "'" + structure_name(f.structure) + "' is not one of the viewer's structures (" +
-                        names + ")");
+                    "'" + structure_name(f.structure) +
+                        "' is not one of the viewer's structures (" + names + ")");
     r.accel = *kind;
     r.ert = f.sampling.early_termination.has_value();
     r.step = f.sampling.step;
@@ -178,7 +179,9 @@ ViewRequest FrameRenderer::view_request(const FrameSpec& f, const TransferFuncti
     return r;
 }
 
-void FrameRenderer::refine() { m_session->refine(); }
+void FrameRenderer::refine() {
+    m_session->refine();
+}
 
 Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     const FrameSpec spec = frame_spec(req, width, height);
@@ -198,7 +201,8 @@ Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     f.stats = r.stats;
     // 3. The reference lattice count for the "space skipped" figure.
     const Camera cam = m_session->camera(spec);
-    f.lattice_samples = count_lattice_samples(m_session->volume(), cam, spec.sampling.step, m_threads);
+    f.lattice_samples =
+        count_lattice_samples(m_session->volume(), cam, spec.sampling.step, m_threads);
     f.skipped = f.lattice_samples && f.stats.samples < f.lattice_samples
                     ? 1.0 - double(f.stats.samples) / double(f.lattice_samples)
                     : 0.0;

@@ -49,7 +49,9 @@ class FrameRenderer {
     // Throws lacuna::Error, keeping the old volume, if the labels cannot label the new one. Not
     // thread-safe against anything: the server calls it with the render thread locked out.
     void set_volume(Volume volume);
-    int label_count() const { return m_session->has_labels() ? m_session->label_table().size() : 0; }
+    int label_count() const {
+        return m_session->has_labels() ? m_session->label_table().size() : 0;
+    }
     // Voxel counts in kHistogramBins equal bins over the visualization range.
     static constexpr int kHistogramBins = 256;
     const std::vector<uint64_t>& histogram() const { return m_histogram; }

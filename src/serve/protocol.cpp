@@ -2,8 +2,8 @@
 
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "lacuna/error.h"
@@ -119,8 +119,11 @@ Vec3d point_of(const json& j, const std::string& where) {
     const json& p = need(j, "point", where);
     bool ok = p.is_array() && p.size() == 3;
     for (size_t i = 0; ok && i < 3; ++i)
-        ok = p[i].is_number() && std::isfinite(p[i].get<double>()) && std::abs(p[i].get<double>()) <= 1e9;
-    if (!ok) reject(where + "point", "expected [x, y, z]: finite numbers (RAS mm), got " + p.dump().substr(0, 80));
+        ok = p[i].is_number() && std::isfinite(p[i].get<double>()) &&
+             std::abs(p[i].get<double>()) <= 1e9;
+    if (!ok)
+        reject(where + "point",
+               "expected [x, y, z]: finite numbers (RAS mm), got " + p.dump().substr(0, 80));
     return {p[0].get<double>(), p[1].get<double>(), p[2].get<double>()};
 }
 
@@ -128,7 +131,8 @@ Interpolation interpolation_of(const json& j, const std::string& where) {
     const std::string name = text_of(j, "interpolation", where);
     if (name == "trilinear") return Interpolation::Trilinear;
     if (name == "nearest") return Interpolation::Nearest;
-    reject(where + "interpolation", "unknown '" + name.substr(0, 40) + "'; expected trilinear or nearest");
+    reject(where + "interpolation",
+           "unknown '" + name.substr(0, 40) + "'; expected trilinear or nearest");
 }
 
 json vec_json(Vec3d v) {
@@ -153,10 +157,14 @@ TransferFunction tf_of(const json& j, const Limits& limits) {
 
 // The message types by kind, in message_names()'s order.
 constexpr std::pair<MessageKind, const char*> kMessageNames[] = {
-    {MessageKind::Render, "render"},         {MessageKind::Slice, "slice"},
-    {MessageKind::Probe, "probe"},           {MessageKind::Screenshot, "screenshot"},
-    {MessageKind::Session, "session"},       {MessageKind::TfExport, "tf_export"},
-    {MessageKind::TfImport, "tf_import"},    {MessageKind::SessionImport, "session_import"},
+    {MessageKind::Render, "render"},
+    {MessageKind::Slice, "slice"},
+    {MessageKind::Probe, "probe"},
+    {MessageKind::Screenshot, "screenshot"},
+    {MessageKind::Session, "session"},
+    {MessageKind::TfExport, "tf_export"},
+    {MessageKind::TfImport, "tf_import"},
+    {MessageKind::SessionImport, "session_import"},
     {MessageKind::VolumeFrame, "volume_frame"}};
 
 const char* message_name(MessageKind k) {
@@ -171,7 +179,8 @@ MessageKind message_kind(std::string_view text, const Limits& limits) {
     for (const auto& [kind, name] : kMessageNames)
         if (type == name) return kind;
     std::string list;
-    for (const auto& [kind, name] : kMessageNames) list += (list.empty() ? "" : ", ") + std::string(name);
+    for (const auto& [kind, name] : kMessageNames)
+        list += (list.empty() ? "" : ", ") + std::string(name);
     reject("type", "unknown message type '" + type.substr(0, 40) + "'; expected one of: " + list);
 }
 
@@ -184,8 +193,9 @@ std::vector<std::string> message_names() {
 SliceRequest parse_slice_request(std::string_view text, const Limits& limits) {
     const json j = parse_json(text, limits);
     if (text_of(j, "type", "") != "slice") reject("type", "expected slice");
-    only_keys(j, {"type", "id", "plane", "point", "window", "level", "interpolation",
-                  "overlay_opacity", "max_size"},
+    only_keys(j,
+              {"type", "id", "plane", "point", "window", "level", "interpolation",
+               "overlay_opacity", "max_size"},
               "");
     SliceRequest r;
     r.id = id_of(j);
@@ -194,11 +204,13 @@ SliceRequest parse_slice_request(std::string_view text, const Limits& limits) {
     const json& w = need(j, "window", "");
     if (!w.is_number() || !std::isfinite(w.get<double>()) || w.get<double>() <= 0 ||
         w.get<double>() > 1e12)
-        reject("window", "expected a positive number (at most 1e12), got " + w.dump().substr(0, 40));
+        reject("window",
+               "expected a positive number (at most 1e12), got " + w.dump().substr(0, 40));
     r.window = w.get<double>();
     r.level = number(j, "level", -1e12, 1e12, "");
     r.interpolation = interpolation_of(j, "");
-    if (j.contains("overlay_opacity")) r.overlay_opacity = float(number(j, "overlay_opacity", 0, 1, ""));
+    if (j.contains("overlay_opacity"))
+        r.overlay_opacity = float(number(j, "overlay_opacity", 0, 1, ""));
     if (j.contains("max_size")) r.max_size = integer(j, "max_size", 1, limits.max_side, "");
     return r;
 }
@@ -243,7 +255,10 @@ std::string slice_message(const SliceInfo& s, std::string_view jpeg) {
 }
 
 std::string probe_message(uint64_t id, const ProbeResult& p) {
-    json j{{"type", "probe"}, {"id", id}, {"point", vec_json(p.world)}, {"inside", p.inside},
+    json j{{"type", "probe"},
+           {"id", id},
+           {"point", vec_json(p.world)},
+           {"inside", p.inside},
            {"index", vec_json(p.index)}};
     j["voxel"] = p.inside ? json::array({p.voxel.x, p.voxel.y, p.voxel.z}) : json(nullptr);
     j["value"] = p.inside ? json(p.value) : json(nullptr);
@@ -272,7 +287,8 @@ std::string session_message(uint64_t id, const std::string& session_text) {
 }
 
 std::string tf_export_message(uint64_t id, TfFileFormat format, const std::string& file_text) {
-    return json{{"type", "tf_export"}, {"id", id}, {"format", to_string(format)}, {"text", file_text}}
+    return json{
+        {"type", "tf_export"}, {"id", id}, {"format", to_string(format)}, {"text", file_text}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
@@ -302,11 +318,12 @@ namespace {
 ViewRequest parse_view(const json& j, MessageKind kind, const Limits& limits) {
     const std::string type = text_of(j, "type", "");
     if (type != message_name(kind))
-        reject("type", "unknown message type '" + type.substr(0, 40) + "'; expected " + message_name(kind));
+        reject("type",
+               "unknown message type '" + type.substr(0, 40) + "'; expected " + message_name(kind));
     if (kind == MessageKind::Render)
         only_keys(j,
-                  {"type", "id", "width", "height", "preview", "camera", "renderer", "accel",
-                   "ert", "step", "tf", "shading", "clip", "clip_planes", "segments", "hide"},
+                  {"type", "id", "width", "height", "preview", "camera", "renderer", "accel", "ert",
+                   "step", "tf", "shading", "clip", "clip_planes", "segments", "hide"},
                   "");
     else
         only_keys(j,
@@ -397,7 +414,8 @@ ViewRequest parse_view(const json& j, MessageKind kind, const Limits& limits) {
     // receives it in the hello message.
     const bool clipped = r.clip || !r.clip_planes.empty();
     if (r.segments && r.renderer != RendererKind::March)
-        reject("segments", "segments are drawn with the ray marcher's lattice ('renderer': 'march')");
+        reject("segments",
+               "segments are drawn with the ray marcher's lattice ('renderer': 'march')");
     const Renderer target = frame_renderer(r.renderer, r.segments);
     const RendererCapabilities& cap = capabilities(target);
     // The field blamed: the toggle that asked for a renderer without the feature.
@@ -424,8 +442,10 @@ ViewRequest parse_request(std::string_view text, const Limits& limits) {
 }
 
 ViewRequest parse_view_request(std::string_view text, MessageKind kind, const Limits& limits) {
-    if (kind != MessageKind::Render && kind != MessageKind::Screenshot && kind != MessageKind::Session)
-        reject("type", std::string("expected render, screenshot or session, not ") + message_name(kind));
+    if (kind != MessageKind::Render && kind != MessageKind::Screenshot &&
+        kind != MessageKind::Session)
+        reject("type",
+               std::string("expected render, screenshot or session, not ") + message_name(kind));
     return parse_view(parse_json(text, limits), kind, limits);
 }
 
@@ -462,7 +482,8 @@ TfImportRequest parse_file_request(std::string_view text, const Limits& limits, 
     r.name = text_of(j, "name", "");
     if (r.name.size() > 255) reject("name", "expected a file name of at most 255 characters");
     for (char c : r.name)
-        if (static_cast<unsigned char>(c) < 0x20) reject("name", "expected a file name without control characters");
+        if (static_cast<unsigned char>(c) < 0x20)
+            reject("name", "expected a file name without control characters");
     r.text = text_of(j, "text", "");
     // The file is JSON (but for a Slicer .vp): bounded in nesting as a message is.
     check_shape(r.text, limits);
@@ -495,7 +516,8 @@ std::string session_import_message(uint64_t id, const ViewRequest& v) {
     std::string view;
     for (const char* name : {"anterior", "posterior", "left", "right", "superior", "inferior"}) {
         float az = 0, el = 0;
-        if (view.empty() && named_view(name, az, el) && az == v.camera.azimuth && el == v.camera.elevation)
+        if (view.empty() && named_view(name, az, el) && az == v.camera.azimuth &&
+            el == v.camera.elevation)
             view = name;
     }
     if (!view.empty()) {
@@ -507,10 +529,16 @@ std::string session_import_message(uint64_t id, const ViewRequest& v) {
     json planes = json::array();
     for (const ClipPlane& p : v.clip_planes)
         planes.push_back({p.normal.x, p.normal.y, p.normal.z, p.d});
-    json state{{"width", v.width},       {"height", v.height},   {"camera", camera},
-               {"renderer", to_string(v.renderer)}, {"accel", to_string(v.accel)},
-               {"ert", v.ert},           {"step", v.step},       {"shading", v.shading},
-               {"clip", v.clip},         {"clip_planes", planes},
+    json state{{"width", v.width},
+               {"height", v.height},
+               {"camera", camera},
+               {"renderer", to_string(v.renderer)},
+               {"accel", to_string(v.accel)},
+               {"ert", v.ert},
+               {"step", v.step},
+               {"shading", v.shading},
+               {"clip", v.clip},
+               {"clip_planes", planes},
                {"tf", json::parse(to_json(v.tf))}};
     return json{{"type", "session_import"}, {"id", id}, {"view", state}}.dump(
         -1, ' ', false, json::error_handler_t::replace);
@@ -522,7 +550,8 @@ Renderer frame_renderer(RendererKind renderer, bool segments) {
 }
 
 Structure frame_structure(AccelKind accel, bool segments, const AccelOptions& o) {
-    return parse_structure(to_string(accel), segments ? Renderer::Segments : Renderer::RayMarcher, o);
+    return parse_structure(to_string(accel), segments ? Renderer::Segments : Renderer::RayMarcher,
+                           o);
 }
 
 std::optional<uint64_t> request_id(std::string_view text, const Limits& limits) {
@@ -555,8 +584,9 @@ json volume_json(const HelloInfo& h) {
 }  // namespace
 
 std::string volume_frame_message(uint64_t id, const HelloInfo& h) {
-    const json j{{"type", "volume_frame"}, {"id", id},         {"frame", h.frame},
-                 {"frames", h.frames},     {"volume", volume_json(h)}, {"histogram", h.histogram}};
+    const json j{{"type", "volume_frame"},   {"id", id},
+                 {"frame", h.frame},         {"frames", h.frames},
+                 {"volume", volume_json(h)}, {"histogram", h.histogram}};
     return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
@@ -576,9 +606,11 @@ std::string hello_message(const HelloInfo& h) {
     j["renderers"] = h.renderers;
     // The capabilities table in the page's words (see protocol.h).
     json caps = json::object();
-    const std::pair<const char*, bool> rows[] = {{"march", false}, {"slice", false}, {"segments", true}};
+    const std::pair<const char*, bool> rows[] = {
+        {"march", false}, {"slice", false}, {"segments", true}};
     for (const auto& [name, segments] : rows) {
-        const RendererKind kind = std::string(name) == "slice" ? RendererKind::Slice : RendererKind::March;
+        const RendererKind kind =
+            std::string(name) == "slice" ? RendererKind::Slice : RendererKind::March;
         const RendererCapabilities& cap = capabilities(frame_renderer(kind, segments));
         json accels = json::array(), features = json::array();
         for (const std::string& a : h.accels)

@@ -112,8 +112,8 @@ struct ViewRequest {
     ViewCamera camera;
     RendererKind renderer = RendererKind::March;
     AccelKind accel = AccelKind::None;
-    bool ert = true;    // early ray termination at 0.99 (false: off)
-    float step = 0.5f;  // sample distance in smallest voxel spacings, [0.1, 8]
+    bool ert = true;       // early ray termination at 0.99 (false: off)
+    float step = 0.5f;     // sample distance in smallest voxel spacings, [0.1, 8]
     bool shading = false;  // optional "shading": Phong with a headlight (docs/shading.md)
     bool clip = false;     // optional "clip": keep x <= the volume's centre (a cut-away)
     // optional "clip_planes": world (patient RAS mm) planes, `lacuna render --clip NX,NY,NZ,D`
@@ -141,7 +141,15 @@ struct ProbeRequest {
 
 // The kinds of message the page sends, by "type".
 enum class MessageKind {
-    Render, Slice, Probe, Screenshot, Session, TfExport, TfImport, SessionImport, VolumeFrame
+    Render,
+    Slice,
+    Probe,
+    Screenshot,
+    Session,
+    TfExport,
+    TfImport,
+    SessionImport,
+    VolumeFrame
 };
 // The message's "type" (throws lacuna::Error("message", "type"/"json"/..., ...) like
 // parse_request for a type not in message_names()).
@@ -201,7 +209,7 @@ struct HelloInfo {
     std::vector<uint64_t> histogram;  // bins over the visualization range
     TransferFunction initial_tf;      // the TF the page starts with
     std::vector<std::string> accels, renderers;
-    int labels = 0;  // label values of the server's label volume (0: none loaded)
+    int labels = 0;        // label values of the server's label volume (0: none loaded)
     bool session = false;  // the server knows its volume's file (session messages can be answered)
     int64_t frames = 1, frame = 0;  // volumes in the server's file (4D NIfTI), the one shown
     Limits limits;

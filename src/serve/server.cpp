@@ -20,9 +20,9 @@
 #include <cstdio>
 #include <deque>
 #include <filesystem>
-#include <nlohmann/json.hpp>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <thread>
@@ -69,7 +69,8 @@ std::string cost_key(const ViewRequest& r) {
 }
 
 // The first field where two session documents differ ("frame.camera.fov_y_deg"), "" if none.
-std::string first_difference(const nlohmann::json& a, const nlohmann::json& b, const std::string& path) {
+std::string first_difference(const nlohmann::json& a, const nlohmann::json& b,
+                             const std::string& path) {
     if (a.is_object() && b.is_object()) {
         for (const auto* side : {&a, &b})
             for (auto it = side->begin(); it != side->end(); ++it) {
@@ -87,7 +88,8 @@ std::string first_difference(const nlohmann::json& a, const nlohmann::json& b, c
 // know the session file's folder) the server's path ends with it, component by component.
 bool same_volume_path(const std::string& session_path, const std::string& server_path) {
     namespace fs = std::filesystem;
-    const fs::path a = fs::path(session_path).lexically_normal(), b = fs::path(server_path).lexically_normal();
+    const fs::path a = fs::path(session_path).lexically_normal(),
+                   b = fs::path(server_path).lexically_normal();
     if (a.is_absolute()) return a == b;
     std::vector<fs::path> ca(a.begin(), a.end()), cb(b.begin(), b.end());
     if (ca.empty() || ca.size() > cb.size()) return false;
@@ -305,12 +307,14 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
     // A screenshot goes to the render thread (it owns the renderer); one per tab at a time.
     void queue_screenshot(const std::string& text) {
-        ViewRequest req = parse_view_request(text, MessageKind::Screenshot, m_server->options.limits);
+        ViewRequest req =
+            parse_view_request(text, MessageKind::Screenshot, m_server->options.limits);
         {
             std::lock_guard<std::mutex> lock(m_server->slot_mutex);
             if (screenshot_busy)
-                throw Error("screenshot", "id",
-                            "this tab's previous screenshot is still rendering; ask for one at a time");
+                throw Error(
+                    "screenshot", "id",
+                    "this tab's previous screenshot is still rendering; ask for one at a time");
             screenshot_busy = true;
             screenshot = std::move(req);
         }
@@ -362,19 +366,21 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             const TfExportRequest req = parse_tf_export_request(text, limits);
             const Volume& v = renderer.volume();
             const double smallest = std::min({v.spacing.x, v.spacing.y, v.spacing.z});
-            send_text(tf_export_message(
-                req.id, req.format,
-                req.format == TfFileFormat::Slicer ? to_slicer_vp_json(req.tf, v.vis_range(), smallest)
-                                                   : to_json(req.tf)));
+            send_text(tf_export_message(req.id, req.format,
+                                        req.format == TfFileFormat::Slicer
+                                            ? to_slicer_vp_json(req.tf, v.vis_range(), smallest)
+                                            : to_json(req.tf)));
             return;
         }
         if (kind == MessageKind::SessionImport) return open_session(text);
         const TfImportRequest req = parse_tf_import_request(text, limits);
         const TransferFunction tf = read_tf_file(req.name, req.text);
-        const size_t points = tf.color.size() + tf.opacity.size() + tf.rendering.gradient_opacity.size();
+        const size_t points =
+            tf.color.size() + tf.opacity.size() + tf.rendering.gradient_opacity.size();
         if (points > size_t(limits.max_tf_points))
-            throw Error(req.name, "points", std::to_string(points) + "; the viewer takes at most " +
-                                                std::to_string(limits.max_tf_points));
+            throw Error(req.name, "points",
+                        std::to_string(points) + "; the viewer takes at most " +
+                            std::to_string(limits.max_tf_points));
         send_text(tf_import_message(req.id, tf));
     }
 
@@ -392,21 +398,27 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
             throw Error(where, "volume.path",
                         "'" + f.volume.path + "' is not this server's volume" +
                             (volume ? " (" + volume->path + ")" : ""));
-        json mine = json::parse(to_json(SessionFile{*volume, f.tf, std::nullopt, f.frame, f.labels}, where));
+        json mine = json::parse(
+            to_json(SessionFile{*volume, f.tf, std::nullopt, f.frame, f.labels}, where));
         json theirs = json::parse(to_json(f, where));
         mine["volume"].erase("path");
         theirs["volume"].erase("path");
-        if (const std::string d = first_difference(theirs["volume"], mine["volume"], "volume"); !d.empty())
-            throw Error(where, d, "differs from the server's volume (lacuna serve's --frame, --range, --dims/--type)");
+        if (const std::string d = first_difference(theirs["volume"], mine["volume"], "volume");
+            !d.empty())
+            throw Error(where, d,
+                        "differs from the server's volume (lacuna serve's --frame, --range, "
+                        "--dims/--type)");
         if (f.tf_back) throw Error(where, "tf_back", "the viewer has no back TF (--tf-back)");
         const ViewRequest view = renderer.view_request(f.frame, f.tf);
         // Exact: the view's frame is the session's, field by field.
         const json want = theirs["frame"];
-        const json got = json::parse(to_json(
-            SessionFile{*volume, f.tf, std::nullopt, renderer.frame_spec(view, view.width, view.height), f.labels},
-            where))["frame"];
+        const json got = json::parse(
+            to_json(SessionFile{*volume, f.tf, std::nullopt,
+                                renderer.frame_spec(view, view.width, view.height), f.labels},
+                    where))["frame"];
         if (const std::string d = first_difference(want, got, "frame"); !d.empty())
-            throw Error(where, d, "the viewer has no control for this value (its frame would differ)");
+            throw Error(where, d,
+                        "the viewer has no control for this value (its frame would differ)");
         // And the page may send it: the answer's view parses as a render message.
         const std::string answer = session_import_message(req.id, view);
         json as_render = json::parse(answer)["view"];
@@ -469,7 +481,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     std::deque<std::string> m_texts;
     std::optional<std::string> m_frame;
     std::deque<std::string> m_binaries;  // slices: answered in order, never dropped
-    std::string m_out;  // the message being written (alive until on_write)
+    std::string m_out;                   // the message being written (alive until on_write)
     bool m_writing = false;
     Clock::time_point m_last_active = Clock::now();  // connect, then the last message read
 };
@@ -603,8 +615,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 };
 
 void Server::Impl::accept() {
-    acceptor.async_accept(net::make_strand(ioc),
-                          beast::bind_front_handler(&Impl::on_accept, this));
+    acceptor.async_accept(net::make_strand(ioc), beast::bind_front_handler(&Impl::on_accept, this));
 }
 
 void Server::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
@@ -874,8 +885,7 @@ Server::~Server() {
 uint16_t Server::start() {
     boost::system::error_code ec;
     const auto address = net::ip::make_address(m->options.host, ec);
-    if (ec)
-        throw Error("serve", "host", "expected an IP address, got '" + m->options.host + "'");
+    if (ec) throw Error("serve", "host", "expected an IP address, got '" + m->options.host + "'");
     m->loopback = address.is_loopback();
     const tcp::endpoint ep{address, m->options.port};
     const std::string where = m->options.host + ":" + std::to_string(m->options.port);

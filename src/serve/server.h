@@ -60,7 +60,7 @@ struct ServerOptions {
     std::chrono::milliseconds evict_idle_after = std::chrono::seconds(30);
     // Estimated render time above which a frame is rendered reduced (0: no budget).
     double render_budget_ms = 2000;
-    std::string volume_name;           // shown by the page
+    std::string volume_name;  // shown by the page
     // The volume's file and read options, for the page's "session" messages (the session file
     // `lacuna render --session` reads); nullopt (a volume made in memory): they are refused.
     std::optional<SessionVolume> session_volume;
@@ -104,7 +104,7 @@ class Server {
         uint64_t budget_reduced = 0;  // frames rendered reduced by the render budget
         uint64_t dropped = 0;         // queued requests of closed tabs, not rendered
         uint64_t started = 0;         // frames the render thread began
-        uint64_t cancelled = 0;       // frames cancelled while rendering (newer request, closed tab)
+        uint64_t cancelled = 0;  // frames cancelled while rendering (newer request, closed tab)
     };
     Stats stats() const;
 

@@ -23,7 +23,9 @@ double seconds_since(Clock::time_point t0) {
 }
 
 // The one place FrameSpec's nullopt becomes the renderers' "off" (lacuna/renderer.h).
-float ert_of(const Sampling& s) { return s.early_termination.value_or(kNoEarlyTermination); }
+float ert_of(const Sampling& s) {
+    return s.early_termination.value_or(kNoEarlyTermination);
+}
 
 // Something built for some TF: it holds version `version` of the session's TF, as the front LUT
 // alone or (two_tfs) as the union of front and back.
@@ -83,7 +85,9 @@ Session::Session(Volume volume, int threads)
 
 Session::~Session() = default;
 
-Box3f Session::bounds() const { return m_brick ? m_whole_bounds : world_bounds(*m_volume); }
+Box3f Session::bounds() const {
+    return m_brick ? m_whole_bounds : world_bounds(*m_volume);
+}
 
 void Session::set_brick(const BrickOwnership& brick, const Box3f& whole_bounds) {
     m_brick = brick;
@@ -122,10 +126,10 @@ const LabelTable& Session::label_table() const {
 
 Camera Session::camera(const FrameSpec& spec) const {
     // The segment renderer frames its label map (the same grid; its geometry may differ).
-    const Box3f b = m_brick ? m_whole_bounds
-                            : world_bounds(spec.renderer == Renderer::Segments && m_labels
-                                               ? *m_labels
-                                               : *m_volume);
+    const Box3f b =
+        m_brick
+            ? m_whole_bounds
+            : world_bounds(spec.renderer == Renderer::Segments && m_labels ? *m_labels : *m_volume);
     OrbitParams op = spec.camera.orbit;
     if (spec.camera.pan_x != 0.f || spec.camera.pan_y != 0.f) {
         // Pan moves the orbit's target along the view plane (the orbit camera's right and up),
@@ -135,7 +139,8 @@ Camera Session::camera(const FrameSpec& spec) const {
         const Vec3f up = base.up();
         const float radius = 0.5f * length(b.extent());
         op.has_target = true;
-        op.target = b.center() + right * (spec.camera.pan_x * radius) + up * (spec.camera.pan_y * radius);
+        op.target =
+            b.center() + right * (spec.camera.pan_x * radius) + up * (spec.camera.pan_y * radius);
     }
     return Camera::orbit(b, op, spec.width, spec.height);
 }
@@ -144,11 +149,13 @@ void Session::check_tfs(const FrameSpec& spec) const {
     const bool labels_alone =
         spec.renderer == Renderer::Segments && spec.segments.mode == SegmentMode::Labels;
     if (!m_has_tf && !labels_alone)
-        throw Error("session", "transfer function", "none was set (Session::set_transfer_function)");
+        throw Error("session", "transfer function",
+                    "none was set (Session::set_transfer_function)");
     if (spec.two_tfs && !m_back_lut)
         throw Error("session", "back transfer function",
                     "two_tfs needs one (Session::set_back_transfer_function)");
-    if (spec.renderer == Renderer::Segments && spec.segments.mode == SegmentMode::Masked && !m_labels)
+    if (spec.renderer == Renderer::Segments && spec.segments.mode == SegmentMode::Masked &&
+        !m_labels)
         throw Error("session", "labels", "mask mode needs a label volume (Session::set_labels)");
 }
 
@@ -250,7 +257,8 @@ void Session::prepare_slicer(const FrameSpec& spec, FrameResult& out) {
         out.build_seconds += seconds_since(t0);
         found = &s.sources.back();
     }
-    out.tf_sync_seconds += sync_tf(*found->source, found->held, m_tf_version, false, m_lut, m_back_lut);
+    out.tf_sync_seconds +=
+        sync_tf(*found->source, found->held, m_tf_version, false, m_lut, m_back_lut);
     s.slicer->set_box_source(found->source.get());
 }
 
@@ -310,16 +318,23 @@ FrameResult Session::prepare(const FrameSpec& spec) {
         if (spec.renderer != Renderer::RayMarcher)
             throw FrameError("renderer", "distributed rendering takes the ray marcher only");
         if (spec.features.any() || spec.two_tfs)
-            throw FrameError("features", "distributed rendering takes no features yet "
-                                         "(shading, clipping, crop, blend, jitter, two TFs)");
+            throw FrameError("features",
+                             "distributed rendering takes no features yet "
+                             "(shading, clipping, crop, blend, jitter, two TFs)");
     }
     if (rgb_colours(*m_volume) && spec.renderer != Renderer::RayMarcher)  // src/render/rgb_march.h
         throw FrameError("renderer", "an RGB volume renders with the ray marcher only");
     FrameResult out;
     switch (spec.renderer) {
-        case Renderer::RayMarcher: prepare_marcher(spec, out); break;
-        case Renderer::Slicer: prepare_slicer(spec, out); break;
-        case Renderer::Segments: prepare_segments(spec, out); break;
+        case Renderer::RayMarcher:
+            prepare_marcher(spec, out);
+            break;
+        case Renderer::Slicer:
+            prepare_slicer(spec, out);
+            break;
+        case Renderer::Segments:
+            prepare_segments(spec, out);
+            break;
     }
     return out;
 }
@@ -351,9 +366,15 @@ SliceOptions slice_options(const FrameSpec& spec, int threads) {
     o.keep_float = spec.keep_float;
     if (spec.slicer.occlusion) {
         switch (spec.slicer.occlusion_use) {
-            case OcclusionUse::CullClip: o.occlusion.mode = OcclusionMode::CullClip; break;
-            case OcclusionUse::CullOnly: o.occlusion.mode = OcclusionMode::CullOnly; break;
-            case OcclusionUse::MapOnly: o.occlusion.mode = OcclusionMode::MapOnly; break;
+            case OcclusionUse::CullClip:
+                o.occlusion.mode = OcclusionMode::CullClip;
+                break;
+            case OcclusionUse::CullOnly:
+                o.occlusion.mode = OcclusionMode::CullOnly;
+                break;
+            case OcclusionUse::MapOnly:
+                o.occlusion.mode = OcclusionMode::MapOnly;
+                break;
         }
         o.occlusion.threshold = spec.slicer.occlusion_threshold;
         o.occlusion.map_size = spec.slicer.occlusion_map;
@@ -386,7 +407,8 @@ FrameResult Session::render(const FrameSpec& spec) {
     FrameResult out = prepare(spec);
     State& s = *m_state;
     const Camera cam = camera(spec);
-    if (!(spec.renderer == Renderer::Slicer && spec.slicer.occlusion && spec.slicer.adaptive_updates))
+    if (!(spec.renderer == Renderer::Slicer && spec.slicer.occlusion &&
+          spec.slicer.adaptive_updates))
         s.adaptive.reset();
     RenderResult r;
     switch (spec.renderer) {
@@ -411,7 +433,8 @@ FrameResult Session::render(const FrameSpec& spec) {
                     !(s.adaptive->slicer == spec.slicer)) {
                     AdaptiveOptions ao;
                     ao.initial = spec.slicer.occlusion_updates;
-                    s.adaptive.emplace(State::Adaptive{spec.structure, spec.slicer, AdaptiveUpdates(ao)});
+                    s.adaptive.emplace(
+                        State::Adaptive{spec.structure, spec.slicer, AdaptiveUpdates(ao)});
                 }
                 adaptive = &s.adaptive->controller;
             }
@@ -457,10 +480,10 @@ void Session::drop_structures() {
 }
 
 const Accel* Session::built_structure(const FrameSpec& spec) const {
-    const bool marched = spec.renderer == Renderer::RayMarcher ||
-                         (spec.renderer == Renderer::Segments &&
-                          spec.segments.mode == SegmentMode::Masked &&
-                          !std::holds_alternative<structure::LabelOctree>(spec.structure));
+    const bool marched =
+        spec.renderer == Renderer::RayMarcher ||
+        (spec.renderer == Renderer::Segments && spec.segments.mode == SegmentMode::Masked &&
+         !std::holds_alternative<structure::LabelOctree>(spec.structure));
     if (!marched) return nullptr;
     for (const auto& b : m_state->accels)
         if (b.structure == spec.structure && b.interpolation == spec.sampling.interpolation)

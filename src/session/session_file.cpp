@@ -1,10 +1,9 @@
 #include "session/session_file.h"
 
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <utility>
 
@@ -24,7 +23,7 @@ const Names<Renderer> kRenderers = {{Renderer::RayMarcher, "raymarcher"},
                                     {Renderer::Slicer, "slicer"},
                                     {Renderer::Segments, "segments"}};
 const Names<SegmentMode> kSegmentModes = {{SegmentMode::Masked, "masked"},
-                                           {SegmentMode::Labels, "labels"}};
+                                          {SegmentMode::Labels, "labels"}};
 const Names<Interpolation> kInterpolations = {{Interpolation::Trilinear, "trilinear"},
                                               {Interpolation::Nearest, "nearest"}};
 const Names<ShadingModel> kShadings = {
@@ -51,10 +50,13 @@ const char* name_of(const Names<E>& names, E e) {
 }
 
 // ---- Writing ------------------------------------------------------------------------------------
-json vec(const Vec3f& v) { return json::array({v.x, v.y, v.z}); }
+json vec(const Vec3f& v) {
+    return json::array({v.x, v.y, v.z});
+}
 
 json octree_json(const structure::Octree& o) {
-    return {{"leaf_cells", o.leaf_cells}, {"initial_level", o.initial_level},
+    return {{"leaf_cells", o.leaf_cells},
+            {"initial_level", o.initial_level},
             {"bidirectional", o.bidirectional}};
 }
 
@@ -74,8 +76,10 @@ json structure_json(const Structure& s) {
                                  std::is_same_v<T, structure::Chebyshev>)
                 return {{"block", st.block}};
             else if constexpr (std::is_same_v<T, structure::KdTree>)
-                return {{"max_boxes", st.max_boxes}, {"delta", st.delta},
-                        {"min_volume", st.min_volume}, {"min_gain", st.min_gain},
+                return {{"max_boxes", st.max_boxes},
+                        {"delta", st.delta},
+                        {"min_volume", st.min_volume},
+                        {"min_gain", st.min_gain},
                         {"max_depth", st.max_depth}};
             else if constexpr (std::is_same_v<T, structure::GrowingBoxes>)
                 return {{"coalesce", st.coalesce}, {"coalesce_edge", st.coalesce_edge}};
@@ -103,21 +107,34 @@ json gradient_opacity_json(const GradientOpacity& g) {
 
 json features_json(const FeatureOptions& f) {
     json planes = json::array();
-    for (const ClipPlane& p : f.clip_planes) planes.push_back({{"normal", vec(p.normal)}, {"d", p.d}});
+    for (const ClipPlane& p : f.clip_planes)
+        planes.push_back({{"normal", vec(p.normal)}, {"d", p.d}});
     return {
         {"shading", name_of(kShadings, f.shading)},
-        {"phong", {{"ambient", f.phong.ambient}, {"diffuse", f.phong.diffuse},
-                   {"specular", f.phong.specular}, {"power", f.phong.power}}},
-        {"pbr", {{"roughness", f.pbr.roughness}, {"metallic", f.pbr.metallic},
-                 {"ambient", f.pbr.ambient}}},
+        {"phong",
+         {{"ambient", f.phong.ambient},
+          {"diffuse", f.phong.diffuse},
+          {"specular", f.phong.specular},
+          {"power", f.phong.power}}},
+        {"pbr",
+         {{"roughness", f.pbr.roughness},
+          {"metallic", f.pbr.metallic},
+          {"ambient", f.pbr.ambient}}},
         {"gradient", name_of(kGradients, f.gradient)},
         {"gradient_opacity", gradient_opacity_json(f.gradient_opacity)},
-        {"light", {{"kind", name_of(kLights, f.light.kind)}, {"direction", vec(f.light.direction)},
-                   {"position", vec(f.light.position)}, {"target", vec(f.light.target)},
-                   {"cone_deg", f.light.cone_deg}, {"intensity", f.light.intensity}}},
-        {"shadows", {{"enabled", f.shadows.enabled}, {"accelerate", f.shadows.accelerate},
-                     {"step", f.shadows.step}, {"light_volume", f.shadows.light_volume},
-                     {"light_volume_stride", f.shadows.light_volume_stride}}},
+        {"light",
+         {{"kind", name_of(kLights, f.light.kind)},
+          {"direction", vec(f.light.direction)},
+          {"position", vec(f.light.position)},
+          {"target", vec(f.light.target)},
+          {"cone_deg", f.light.cone_deg},
+          {"intensity", f.light.intensity}}},
+        {"shadows",
+         {{"enabled", f.shadows.enabled},
+          {"accelerate", f.shadows.accelerate},
+          {"step", f.shadows.step},
+          {"light_volume", f.shadows.light_volume},
+          {"light_volume_stride", f.shadows.light_volume_stride}}},
         {"clip_planes", planes},
         {"crop", f.crop},
         {"crop_box", {{"lo", vec(f.crop_box.lo)}, {"hi", vec(f.crop_box.hi)}}},
@@ -135,8 +152,10 @@ json segments_json(const SegmentsSpec& s) {
     if (s.labels) {
         table = json::array();
         for (const LabelStyle& l : s.labels->styles)
-            table.push_back({{"name", l.name}, {"color", json::array({l.r, l.g, l.b})},
-                             {"opacity", l.opacity}, {"visible", l.visible}});
+            table.push_back({{"name", l.name},
+                             {"color", json::array({l.r, l.g, l.b})},
+                             {"opacity", l.opacity},
+                             {"visible", l.visible}});
     }
     return {{"mode", name_of(kSegmentModes, s.mode)}, {"tint", s.tint}, {"table", table}};
 }
@@ -146,25 +165,31 @@ json frame_json(const FrameSpec& f) {
     json j = {
         {"renderer", name_of(kRenderers, f.renderer)},
         {"structure", structure_json(f.structure)},
-        {"sampling", {{"step", f.sampling.step},
-                      {"early_termination", f.sampling.early_termination
-                                                ? json(*f.sampling.early_termination)
-                                                : json(nullptr)},
-                      {"interpolation", name_of(kInterpolations, f.sampling.interpolation)}}},
+        {"sampling",
+         {{"step", f.sampling.step},
+          {"early_termination",
+           f.sampling.early_termination ? json(*f.sampling.early_termination) : json(nullptr)},
+          {"interpolation", name_of(kInterpolations, f.sampling.interpolation)}}},
         {"features", features_json(f.features)},
         {"two_tfs", f.two_tfs},
-        {"slicer", {{"occlusion", f.slicer.occlusion},
-                    {"occlusion_threshold", f.slicer.occlusion_threshold},
-                    {"occlusion_map", f.slicer.occlusion_map},
-                    {"occlusion_use", name_of(kOcclusionUses, f.slicer.occlusion_use)},
-                    {"occlusion_updates", f.slicer.occlusion_updates},
-                    {"adaptive_updates", f.slicer.adaptive_updates}}},
-        {"camera", {{"azimuth_deg", o.azimuth_deg}, {"elevation_deg", o.elevation_deg},
-                    {"zoom", o.zoom}, {"distance", o.distance},
-                    {"target", o.has_target ? vec(o.target) : json(nullptr)}, {"up", vec(o.up)},
-                    {"fov_y_deg", o.fov_y_deg},
-                    {"projection", name_of(kProjections, o.projection)},
-                    {"pan_x", f.camera.pan_x}, {"pan_y", f.camera.pan_y}}},
+        {"slicer",
+         {{"occlusion", f.slicer.occlusion},
+          {"occlusion_threshold", f.slicer.occlusion_threshold},
+          {"occlusion_map", f.slicer.occlusion_map},
+          {"occlusion_use", name_of(kOcclusionUses, f.slicer.occlusion_use)},
+          {"occlusion_updates", f.slicer.occlusion_updates},
+          {"adaptive_updates", f.slicer.adaptive_updates}}},
+        {"camera",
+         {{"azimuth_deg", o.azimuth_deg},
+          {"elevation_deg", o.elevation_deg},
+          {"zoom", o.zoom},
+          {"distance", o.distance},
+          {"target", o.has_target ? vec(o.target) : json(nullptr)},
+          {"up", vec(o.up)},
+          {"fov_y_deg", o.fov_y_deg},
+          {"projection", name_of(kProjections, o.projection)},
+          {"pan_x", f.camera.pan_x},
+          {"pan_y", f.camera.pan_y}}},
         {"width", f.width},
         {"height", f.height},
         {"background", vec(f.background)},
@@ -176,18 +201,21 @@ json frame_json(const FrameSpec& f) {
 
 // ---- Reading: each value through one of these, which name the field on a mismatch ------------
 class Reader {
-public:
+  public:
     Reader(const json& j, std::string field, const std::string& where)
         : m_j(j), m_field(std::move(field)), m_where(where) {}
 
     [[noreturn]] void fail(const std::string& field, const std::string& what) const {
         throw Error(m_where, field, what);
     }
-    std::string sub(const std::string& key) const { return m_field.empty() ? key : m_field + "." + key; }
+    std::string sub(const std::string& key) const {
+        return m_field.empty() ? key : m_field + "." + key;
+    }
 
     // The object's keys must all be in `known`.
     void expect_object(std::initializer_list<const char*> known) const {
-        if (!m_j.is_object()) fail(m_field, std::string("expected an object, got ") + m_j.type_name());
+        if (!m_j.is_object())
+            fail(m_field, std::string("expected an object, got ") + m_j.type_name());
         for (const auto& [k, v] : m_j.items()) {
             bool ok = false;
             for (const char* n : known) ok = ok || k == n;
@@ -270,7 +298,7 @@ public:
         fail(sub(key), "expected one of " + list + ", got '" + s + "'");
     }
 
-private:
+  private:
     const json& m_j;
     std::string m_field;
     const std::string& m_where;
@@ -310,7 +338,8 @@ Structure read_structure(const Reader& r, Renderer renderer) {
                 r.expect_object({"name", "block"});
                 r.get("block", st.block);
             } else if constexpr (std::is_same_v<T, structure::KdTree>) {
-                r.expect_object({"name", "max_boxes", "delta", "min_volume", "min_gain", "max_depth"});
+                r.expect_object(
+                    {"name", "max_boxes", "delta", "min_volume", "min_gain", "max_depth"});
                 r.get("max_boxes", st.max_boxes);
                 r.get("delta", st.delta);
                 r.get("min_volume", st.min_volume);
@@ -452,8 +481,8 @@ SegmentsSpec read_segments(const Reader& r) {
 }
 
 FrameSpec read_frame(const Reader& r) {
-    r.expect_object({"renderer", "structure", "sampling", "features", "two_tfs", "slicer",
-                     "camera", "width", "height", "background", "count_samples", "segments"});
+    r.expect_object({"renderer", "structure", "sampling", "features", "two_tfs", "slicer", "camera",
+                     "width", "height", "background", "count_samples", "segments"});
     FrameSpec f;
     r.get("renderer", f.renderer, kRenderers);
     if (r.has("segments")) {
@@ -571,10 +600,12 @@ TransferFunction read_tf(const Reader& r) {
 
 // Labels belong to (and are needed by) exactly the segment renderer's mask mode.
 void check_labels(const SessionFile& s, const std::string& where) {
-    const bool needs = s.frame.renderer == Renderer::Segments && s.frame.segments.mode == SegmentMode::Masked;
+    const bool needs =
+        s.frame.renderer == Renderer::Segments && s.frame.segments.mode == SegmentMode::Masked;
     if (needs && (!s.labels || s.labels->empty()))
-        throw Error(where, "labels", "missing (frame.renderer is segments in mask mode: the frame "
-                                     "needs the label volume's path)");
+        throw Error(where, "labels",
+                    "missing (frame.renderer is segments in mask mode: the frame "
+                    "needs the label volume's path)");
     if (!needs && s.labels)
         throw Error(where, "labels", "given, but only the segment renderer's mask mode reads one");
 }
@@ -626,13 +657,13 @@ SessionFile parse_session_file(const std::string& text, const std::string& where
         const Reader l = r.at("labels");
         l.expect_object({"path"});
         s.labels = l.text("path");
-        if (s.labels->empty()) l.fail(l.sub("path"), "expected a label volume file name, got an empty string");
+        if (s.labels->empty())
+            l.fail(l.sub("path"), "expected a label volume file name, got an empty string");
     }
     check_labels(s, where);
     if (s.frame.two_tfs && !s.tf_back)
         r.fail("tf_back", "missing (frame.two_tfs is true: the frame needs the back TF)");
-    if (!s.frame.two_tfs && s.tf_back)
-        r.fail("tf_back", "given, but frame.two_tfs is false");
+    if (!s.frame.two_tfs && s.tf_back) r.fail("tf_back", "given, but frame.two_tfs is false");
     try {
         validate(s.frame);
     } catch (const FrameError& e) {
@@ -654,7 +685,8 @@ SessionFile load_session_file(const std::string& path) {
     if (!in && !in.eof()) throw Error(path, "session", "cannot read the file");
     SessionFile s = parse_session_file(text.str(), path);
     const fs::path vp(s.volume.path);
-    if (vp.is_relative()) s.volume.path = (fs::path(path).parent_path() / vp).lexically_normal().string();
+    if (vp.is_relative())
+        s.volume.path = (fs::path(path).parent_path() / vp).lexically_normal().string();
     if (s.labels && fs::path(*s.labels).is_relative())
         s.labels = (fs::path(path).parent_path() / *s.labels).lexically_normal().string();
     return s;

@@ -20,7 +20,9 @@ fs::path temp_dir() {
     static const fs::path dir = lacuna::test::cli_temp_dir("cli-rgb");
     return dir;
 }
-lacuna::test::CliResult run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+lacuna::test::CliResult run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 // A 24^3 RGB24 file: a red ball, a green ring around it, black elsewhere.
 fs::path rgb_file() {
@@ -48,7 +50,8 @@ fs::path rgb_file() {
 TEST(CliRgb, InfoNamesTheChannelsAndTheOpacityScalar) {
     const auto r = run("info " + rgb_file().string());
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_NE(r.out.find("channels:    RGB (RGB24) (colour from the data; opacity scalar: luminance, Rec. 709 float32)"),
+    EXPECT_NE(r.out.find("channels:    RGB (RGB24) (colour from the data; opacity scalar: "
+                         "luminance, Rec. 709 float32)"),
               std::string::npos)
         << r.out;
     const auto g = run("info " + rgb_file().string() + " --rgb-opacity g");
@@ -58,7 +61,8 @@ TEST(CliRgb, InfoNamesTheChannelsAndTheOpacityScalar) {
 }
 
 TEST(CliRgb, EveryAccelRendersTheNoneImage) {
-    const std::string base = "render " + rgb_file().string() + " --tf mr-default --size 48 --azimuth 35 ";
+    const std::string base =
+        "render " + rgb_file().string() + " --tf mr-default --size 48 --azimuth 35 ";
     const fs::path ref = temp_dir() / "none.png";
     ASSERT_EQ(run(base + "--accel none --out " + ref.string()).code, 0);
     for (const char* accel : {"grid", "bitfield", "minmax", "kdtree"}) {
@@ -76,14 +80,18 @@ TEST(CliRgb, EveryAccelRendersTheNoneImage) {
 TEST(CliRgb, WhatRgbCannotDoIsOneLine) {
     const fs::path out = temp_dir() / "bad.png";
     const std::string f = rgb_file().string();
-    expect_one_line_error(run("render " + f + " --tf mr-default --rgb-opacity a --out " + out.string()),
-                          "rgb opacity: expected luminance, r, g or b: the file has no alpha channel (RGB24), got a");
-    expect_one_line_error(run("render " + f + " --tf mr-default --rgb-opacity luma --out " + out.string()),
-                          "--rgb-opacity: rgb opacity: expected one of: luminance, r, g, b, a; got 'luma'");
-    expect_one_line_error(run("render " + f + " --tf mr-default --shading phong --out " + out.string()),
-                          "for an RGB volume: its colour comes from the data");
-    expect_one_line_error(run("render " + f + " --tf mr-default --renderer slice --out " + out.string()),
-                          "an RGB volume renders with the ray marcher only");
+    expect_one_line_error(
+        run("render " + f + " --tf mr-default --rgb-opacity a --out " + out.string()),
+        "rgb opacity: expected luminance, r, g or b: the file has no alpha channel (RGB24), got a");
+    expect_one_line_error(
+        run("render " + f + " --tf mr-default --rgb-opacity luma --out " + out.string()),
+        "--rgb-opacity: rgb opacity: expected one of: luminance, r, g, b, a; got 'luma'");
+    expect_one_line_error(
+        run("render " + f + " --tf mr-default --shading phong --out " + out.string()),
+        "for an RGB volume: its colour comes from the data");
+    expect_one_line_error(
+        run("render " + f + " --tf mr-default --renderer slice --out " + out.string()),
+        "an RGB volume renders with the ray marcher only");
     EXPECT_FALSE(fs::exists(out));
 }
 

@@ -26,7 +26,9 @@ fs::path temp_dir() {
     return dir;
 }
 
-CliResult run(const std::string& args) { return lacuna::test::run_cli(args, temp_dir()); }
+CliResult run(const std::string& args) {
+    return lacuna::test::run_cli(args, temp_dir());
+}
 
 const fs::path& volume() {
     static const fs::path p = [] {
@@ -60,7 +62,8 @@ TEST(CliSession, SavedSessionRendersTheSameBytes) {
     int i = 0;
     for (const std::string& flags : cases) {
         const std::string n = std::to_string(i++);
-        const fs::path a = temp_dir() / ("flags" + n + ".png"), b = temp_dir() / ("file" + n + ".png"),
+        const fs::path a = temp_dir() / ("flags" + n + ".png"),
+                       b = temp_dir() / ("file" + n + ".png"),
                        json = temp_dir() / ("s" + n + ".json");
         const CliResult r1 = run("render " + volume().string() + flags + " --out " + a.string() +
                                  " --save-session " + json.string());
@@ -85,7 +88,8 @@ TEST(CliSession, OrbitFromASessionStartsAtItsFrame) {
                   a.string() + " --save-session " + json.string())
                   .code,
               0);
-    const CliResult r = run("render --session " + json.string() + " --orbit 2 --out " + seq.string());
+    const CliResult r =
+        run("render --session " + json.string() + " --orbit 2 --out " + seq.string());
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(slurp_file(a), slurp_file(temp_dir() / "oseq_0000.png"));
 }
@@ -104,7 +108,8 @@ TEST(CliSession, RelativeVolumePathIsBesideTheFile) {
     fs::create_directories(sub);
     fs::copy_file(volume(), sub / volume().filename(), fs::copy_options::overwrite_existing);
     write(sub / "rel.json", j.dump());
-    const CliResult r = run("render --session " + (sub / "rel.json").string() + " --out " + b.string());
+    const CliResult r =
+        run("render --session " + (sub / "rel.json").string() + " --out " + b.string());
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(slurp_file(a), slurp_file(b));
 }
@@ -130,13 +135,17 @@ TEST(CliSession, MalformedFilesNameTheFieldAndWriteNothing) {
          "frame.camera.azimut_deg: unknown key"},
         {"unknown structure", [](auto& j) { j["frame"]["structure"]["name"] = "quadtree"; },
          "frame.structure.name"},
-        {"bad bits", [](auto& j) { j["frame"]["structure"] = {{"name", "bitfield"}, {"bits", 7}}; },
+        {"bad bits",
+         [](auto& j) {
+             j["frame"]["structure"] = {{"name", "bitfield"}, {"bits", 7}};
+         },
          "frame.structure.bits"},
         {"bad projection", [](auto& j) { j["frame"]["camera"]["projection"] = "fisheye"; },
          "frame.camera.projection: expected one of perspective, orthographic"},
         {"width not integer", [](auto& j) { j["frame"]["width"] = 1.5; }, "frame.width"},
         {"no volume", [](auto& j) { j.erase("volume"); }, "volume: missing"},
-        {"volume path number", [](auto& j) { j["volume"]["path"] = 3; }, "volume.path: expected a string"},
+        {"volume path number", [](auto& j) { j["volume"]["path"] = 3; },
+         "volume.path: expected a string"},
         {"bad tf", [](auto& j) { j["tf"]["opacity"] = "x"; }, ": tf: "},
         {"version", [](auto& j) { j["lacuna_session"] = 2; }, "lacuna_session: expected 1"},
         {"two_tfs without back", [](auto& j) { j["frame"]["two_tfs"] = true; }, "tf_back: missing"},
@@ -147,19 +156,26 @@ TEST(CliSession, MalformedFilesNameTheFieldAndWriteNothing) {
              j["frame"]["structure"] = {{"name", "label-octree"}};
          },
          "labels: missing (frame.renderer is segments in mask mode"},
-        {"background short", [](auto& j) { j["frame"]["background"] = {0, 0}; },
+        {"background short",
+         [](auto& j) {
+             j["frame"]["background"] = {0, 0};
+         },
          "frame.background: expected an array of three numbers"},
         {"gradient points not pairs",
-         [](auto& j) { j["frame"]["features"]["gradient_opacity"]["points"] = {{0, 0, 1}}; },
+         [](auto& j) {
+             j["frame"]["features"]["gradient_opacity"]["points"] = {{0, 0, 1}};
+         },
          "frame.features.gradient_opacity.points[0]: expected [x, a]"},
         {"gradient points unsorted",
          [](auto& j) {
-             j["frame"]["features"]["gradient_opacity"] = {{"enabled", true}, {"lo", 0}, {"hi", 1},
-                                                          {"points", {{5, 0}, {1, 1}}}};
+             j["frame"]["features"]["gradient_opacity"] = {
+                 {"enabled", true}, {"lo", 0}, {"hi", 1}, {"points", {{5, 0}, {1, 1}}}};
          },
          "features.gradient_opacity.points: expected points sorted by x"},
         {"gradient points empty",
-         [](auto& j) { j["frame"]["features"]["gradient_opacity"]["points"] = nlohmann::json::array(); },
+         [](auto& j) {
+             j["frame"]["features"]["gradient_opacity"]["points"] = nlohmann::json::array();
+         },
          "frame.features.gradient_opacity.points: expected a non-empty array"},
     };
     int i = 0;
@@ -178,21 +194,23 @@ TEST(CliSession, MalformedFilesNameTheFieldAndWriteNothing) {
     }
     // Not JSON at all, and a missing file.
     write(temp_dir() / "text.json", "{\"lacuna_session\": 1,");
-    expect_one_line_error(run("render --session " + (temp_dir() / "text.json").string() +
-                              " --out " + out.string()),
-                          "json: not valid JSON");
-    expect_one_line_error(run("render --session " + (temp_dir() / "none.json").string() +
-                              " --out " + out.string()),
-                          "none.json: session: not a readable file");
+    expect_one_line_error(
+        run("render --session " + (temp_dir() / "text.json").string() + " --out " + out.string()),
+        "json: not valid JSON");
+    expect_one_line_error(
+        run("render --session " + (temp_dir() / "none.json").string() + " --out " + out.string()),
+        "none.json: session: not a readable file");
     // A flag that would change the frame is refused, not ignored.
-    expect_one_line_error(run("render --session " + good.string() + " --size 64 --out " + out.string()),
-                          "--session: flags: the session file sets the frame; drop --size");
+    expect_one_line_error(
+        run("render --session " + good.string() + " --size 64 --out " + out.string()),
+        "--session: flags: the session file sets the frame; drop --size");
     EXPECT_FALSE(fs::exists(out));
     // --save-session of what a file cannot hold (segments) fails before rendering.
     const fs::path seg_json = temp_dir() / "seg.json";
-    expect_one_line_error(run("render " + volume().string() + " --segments labels --size 16 --out " +
-                              out.string() + " --save-session " + seg_json.string()),
-                          "--save-session: frame.renderer");
+    expect_one_line_error(
+        run("render " + volume().string() + " --segments labels --size 16 --out " + out.string() +
+            " --save-session " + seg_json.string()),
+        "--save-session: frame.renderer");
     EXPECT_FALSE(fs::exists(seg_json));
     EXPECT_FALSE(fs::exists(out));
 }
@@ -225,7 +243,8 @@ TEST(SessionFile, RoundTripIsExact) {
     s.frame.sampling.early_termination = std::nullopt;
     s.frame.structure = lacuna::structure::KdTree{5, 2, 0.3f, 0.07f, 6};
     s.frame.features.gradient_opacity.enabled = true;
-    s.frame.features.gradient_opacity.points = {{0.f, 0.f}, {2.5f, 0.f}, {2.5f, 1.f / 3.f}, {1e4f, 1.f}};
+    s.frame.features.gradient_opacity.points = {
+        {0.f, 0.f}, {2.5f, 0.f}, {2.5f, 1.f / 3.f}, {1e4f, 1.f}};
     const std::string text = lacuna::to_json(s);
     const lacuna::SessionFile t = lacuna::parse_session_file(text, "x.json");
     EXPECT_EQ(lacuna::to_json(t), text);

@@ -205,8 +205,7 @@ TEST(IoMalformed, NrrdDataFileOfOnlyWhitespaceIsRejected) {
     const std::string found = "\x01NRRD20at)\ndata file:\x0c";
     test::write_bytes(dir.file("ff.nhdr"), std::vector<uint8_t>(found.begin(), found.end()));
     expect_read_error(dir.file("ff.nhdr"), {});
-    test::write_text(dir.file("ff2.nhdr"),
-                     nrrd_header("uint8", "4 4 4", 3, "data file: \x0c\v\n"));
+    test::write_text(dir.file("ff2.nhdr"), nrrd_header("uint8", "4 4 4", 3, "data file: \x0c\v\n"));
     expect_read_error(dir.file("ff2.nhdr"), {"data file"});
 }
 
@@ -370,7 +369,8 @@ TEST(IoMalformed, TimeSeriesNeedAFrameButOneTimePointDoesNot) {
     test::write_bytes(dir.file("t3.nii"), test::nifti_bytes(spec, vox.data(), vox.size()));
     // A 4D NIfTI file is read volume by volume (ReadOptions::frame); without one it says how
     // many it holds. Other formats' 4D images stay refused.
-    expect_read_error(dir.file("t3.nii"), {"frame: the file holds 3 volumes along dim[4]; choose one (0..2)"});
+    expect_read_error(dir.file("t3.nii"),
+                      {"frame: the file holds 3 volumes along dim[4]; choose one (0..2)"});
 }
 
 // RGB NRRD is not read (yet); RGB NIfTI is (docs/formats.md, "RGB volumes"), but one whose
@@ -389,7 +389,8 @@ TEST(IoMalformed, RgbNrrdIsNotScalarAndAMisdeclaredRgbNiftiIsRefused) {
     EXPECT_NE(rgb_colours(read_volume(dir.file("rgb.nii"))), nullptr);
     spec.bitpix = 16;
     test::write_bytes(dir.file("bad.nii"), test::nifti_bytes(spec, vox.data(), vox.size()));
-    expect_read_error(dir.file("bad.nii"), {"bitpix: expected 24 for RGB24 (datatype 128), got 16"});
+    expect_read_error(dir.file("bad.nii"),
+                      {"bitpix: expected 24 for RGB24 (datatype 128), got 16"});
 }
 
 TEST(IoMalformed, ComplexImagesAreRejected) {
@@ -429,7 +430,8 @@ TEST(IoMalformed, APairsHeaderNamedNiiIsRejected) {  // (pairs are read as .hdr 
     spec.magic = std::string("ni1\0", 4);
     std::vector<uint8_t> vox(8);
     test::write_bytes(dir.file("pair.nii"), test::nifti_bytes(spec, vox.data(), vox.size()));
-    expect_read_error(dir.file("pair.nii"), {"separate .img file (magic 'ni1'): name it .hdr beside its .img"});
+    expect_read_error(dir.file("pair.nii"),
+                      {"separate .img file (magic 'ni1'): name it .hdr beside its .img"});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -31,8 +31,8 @@ std::vector<uint8_t> colours(Vec3i d, int channels) {
     return out;
 }
 
-std::string write_rgb(const ScratchDir& dir, const std::string& name, int channels, Vec3i d = {3, 4, 2},
-                      NiftiSpec s = {}) {
+std::string write_rgb(const ScratchDir& dir, const std::string& name, int channels,
+                      Vec3i d = {3, 4, 2}, NiftiSpec s = {}) {
     s.dims = d;
     s.datatype = channels == 3 ? 128 : 2304;
     const std::vector<uint8_t> v = colours(d, channels);
@@ -83,7 +83,9 @@ TEST(RgbVolume, MalformedRgbHeadersAreOneLine) {
     ScratchDir dir;
     NiftiSpec bad_bitpix;
     bad_bitpix.bitpix = 8;
-    EXPECT_EQ(error_of([&] { read_volume(write_rgb(dir, "b.nii", 3, {3, 4, 2}, bad_bitpix)); }),
+    EXPECT_EQ(error_of([&] {
+                  read_volume(write_rgb(dir, "b.nii", 3, {3, 4, 2}, bad_bitpix));
+              }),
               dir.file("b.nii") + ": bitpix: expected 24 for RGB24 (datatype 128), got 8");
     EXPECT_EQ(error_of([&] { read_volume(write_rgb(dir, "a.nii", 3), {}, RgbOpacity::A); }),
               dir.file("a.nii") +
@@ -106,7 +108,9 @@ TEST(RgbVolume, MalformedRgbHeadersAreOneLine) {
     NiftiSpec vec;
     vec.ndim = 5;
     vec.dim5 = 3;
-    const std::string ve = error_of([&] { read_volume(write_rgb(dir, "v.nii", 3, {3, 4, 2}, vec)); });
+    const std::string ve = error_of([&] {
+        read_volume(write_rgb(dir, "v.nii", 3, {3, 4, 2}, vec));
+    });
     EXPECT_NE(ve.find("dims: expected a scalar image, got 3 components"), std::string::npos) << ve;
     for (const std::string& e : {t, tz, ve}) EXPECT_EQ(e.find('\n'), std::string::npos) << e;
     EXPECT_EQ(error_of([] { parse_rgb_opacity("luma"); }),

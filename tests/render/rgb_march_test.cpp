@@ -52,13 +52,15 @@ std::array<uint8_t, 3> blobs(int i, int j, int k) {
                     uint8_t(b == 1 ? 230 - 4 * k : 90 + 3 * i),
                     uint8_t(b == 2 ? 250 - 6 * j % 70 : 40 + 7 * k)};
     }
-    return {uint8_t((i * 7 + j * 3) % 13), uint8_t((j * 5 + k * 11) % 11), uint8_t((i + k * 2) % 17)};
+    return {uint8_t((i * 7 + j * 3) % 13), uint8_t((j * 5 + k * 11) % 11),
+            uint8_t((i + k * 2) % 17)};
 }
 
 TransferFunction ramp(double lo, double hi, float top) {
     TransferFunction tf;
     tf.name = "ramp";
-    tf.color = {{0.0, 0.f, 1.f, 0.f}, {1.0, 0.f, 1.f, 0.f}};  // green: never seen (data colour wins)
+    tf.color = {{0.0, 0.f, 1.f, 0.f},
+                {1.0, 0.f, 1.f, 0.f}};  // green: never seen (data colour wins)
     tf.opacity = {{0.0, 0.f}};
     if (lo > 0.0) tf.opacity.push_back({lo, 0.f});
     tf.opacity.push_back({hi, top});
@@ -97,7 +99,8 @@ TEST(RgbMarch, EveryStructureGivesTheNoneImage) {
     for (const TransferFunction& tf : {ramp(0.3, 0.5, 0.4f), ramp(0.55, 0.6, 1.f)}) {
         session.set_transfer_function(tf);
         for (const Interpolation interp : {Interpolation::Trilinear, Interpolation::Nearest}) {
-            for (const std::optional<float> ert : {std::optional<float>(0.95f), std::optional<float>()}) {
+            for (const std::optional<float> ert :
+                 {std::optional<float>(0.95f), std::optional<float>()}) {
                 FrameSpec ref = spec(structure::None{});
                 ref.sampling.interpolation = interp;
                 ref.sampling.early_termination = ert;
@@ -130,9 +133,10 @@ TEST(RgbMarch, EveryStructureGivesTheNoneImage) {
 
 TEST(RgbMarch, ConstantColourRendersAsThatColour) {
     ScratchDir dir;
-    Session session(rgb_file(dir, {9, 8, 7}, [](int, int, int) {
-                        return std::array<uint8_t, 3>{200, 100, 50};
-                    }),
+    Session session(rgb_file(dir, {9, 8, 7},
+                             [](int, int, int) {
+                                 return std::array<uint8_t, 3>{200, 100, 50};
+                             }),
                     1);
     // Opacity 1: the first sample is opaque, so a pixel of the volume is its colour exactly.
     session.set_transfer_function(flat(1.f));

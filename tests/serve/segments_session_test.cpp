@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 
 fs::path temp_dir() {
     static fs::path dir = [] {
-        fs::path d = fs::temp_directory_path() / ("lacuna-segsession-" + std::to_string(::getpid()));
+        fs::path d =
+            fs::temp_directory_path() / ("lacuna-segsession-" + std::to_string(::getpid()));
         fs::create_directories(d);
         return d;
     }();
@@ -47,7 +48,8 @@ TEST(SegmentsSession, TheSavedSessionRendersTheScreenshotWithSegmentsAndHiddenLa
                 labels.set_value(i, j, k, u > 0.75f ? 3.f : u > 0.5f ? 2.f : u > 0.25f ? 1.f : 0.f);
             }
     labels.compute_range();
-    const fs::path volume_path = temp_dir() / "shells.nrrd", labels_path = temp_dir() / "labels.nrrd";
+    const fs::path volume_path = temp_dir() / "shells.nrrd",
+                   labels_path = temp_dir() / "labels.nrrd";
     write_volume(volume_path.string(), shells);
     write_volume(labels_path.string(), labels);
 
@@ -106,7 +108,8 @@ TEST(SegmentsSession, TheSavedSessionRendersTheScreenshotWithSegmentsAndHiddenLa
                             session_file.string() + " --out " + out.string() + " >/dev/null";
     const int status = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd;
-    EXPECT_EQ(read_all(out), shot.jpeg) << "the CLI's PNG of the segments session is the screenshot";
+    EXPECT_EQ(read_all(out), shot.jpeg)
+        << "the CLI's PNG of the segments session is the screenshot";
     server.stop();
     t.join();
 }
@@ -132,7 +135,8 @@ TEST(SegmentsSession, TheFileRoundTripsAndNamesWhatIsMissing) {
     EXPECT_EQ(to_json(back, "s.json"), text);
     ASSERT_TRUE(back.frame.segments.labels);
     for (int l = 0; l < 3; ++l) {
-        const LabelStyle &a = t.styles[size_t(l)], &b = back.frame.segments.labels->styles[size_t(l)];
+        const LabelStyle &a = t.styles[size_t(l)],
+                         &b = back.frame.segments.labels->styles[size_t(l)];
         EXPECT_EQ(a.name, b.name);
         EXPECT_EQ(a.r, b.r);
         EXPECT_EQ(a.g, b.g);
@@ -157,20 +161,23 @@ TEST(SegmentsSession, TheFileRoundTripsAndNamesWhatIsMissing) {
               std::string::npos);
     json j = json::parse(text);
     j.erase("labels");
-    EXPECT_NE(error_of([&] { parse_session_file(j.dump(), "s.json"); }).find("s.json: labels: missing"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of([&] { parse_session_file(j.dump(), "s.json"); }).find("s.json: labels: missing"),
+        std::string::npos);
     j = json::parse(text);
     j["frame"]["renderer"] = "raymarcher";
     j["frame"]["structure"] = {{"name", "grid"}};
-    EXPECT_NE(error_of([&] { parse_session_file(j.dump(), "s.json"); }).find("frame.segments: given"),
-              std::string::npos);
+    EXPECT_NE(
+        error_of([&] { parse_session_file(j.dump(), "s.json"); }).find("frame.segments: given"),
+        std::string::npos);
     j["frame"].erase("segments");
     EXPECT_NE(error_of([&] { parse_session_file(j.dump(), "s.json"); }).find("labels: given"),
               std::string::npos);
     j = json::parse(text);
     j["frame"]["segments"]["table"][1]["opacity"] = -1;
-    EXPECT_NE(error_of([&] { parse_session_file(j.dump(), "s.json"); })
-                  .find("frame.segments.table[1].opacity: expected a number >= 0"),
+    EXPECT_NE(error_of([&] {
+                  parse_session_file(j.dump(), "s.json");
+              }).find("frame.segments.table[1].opacity: expected a number >= 0"),
               std::string::npos);
     // Labels mode needs no label volume (the volume is the label map).
     SessionFile labels_mode = s;

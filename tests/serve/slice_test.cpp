@@ -18,9 +18,12 @@ using namespace lacuna::serve::test;
 namespace {
 
 json slice_json(uint64_t id) {
-    return json{{"type", "slice"},       {"id", id},
-                {"plane", "coronal"},    {"point", {1.5, -2.0, 3.25}},
-                {"window", 180},         {"level", 90},
+    return json{{"type", "slice"},
+                {"id", id},
+                {"plane", "coronal"},
+                {"point", {1.5, -2.0, 3.25}},
+                {"window", 180},
+                {"level", 90},
                 {"interpolation", "trilinear"}};
 }
 
@@ -106,14 +109,29 @@ TEST(SliceProtocol, ErrorsNameTheField) {
         json value;  // null: remove the field
     };
     const Case cases[] = {
-        {"plane", "oblique"},      {"plane", 3},           {"plane", nullptr},
-        {"point", {1, 2}},         {"point", {1, "a", 2}}, {"point", nullptr},
-        {"point", {1, 2, 1e300}},  {"window", 0},          {"window", -4},
-        {"window", "wide"},        {"window", nullptr},    {"level", "x"},
-        {"level", nullptr},        {"interpolation", "cubic"}, {"interpolation", nullptr},
-        {"overlay_opacity", 1.5},  {"overlay_opacity", -0.1}, {"max_size", 0},
-        {"max_size", 100000},      {"max_size", 2.5},      {"id", -1},
-        {"id", nullptr},           {"colour", 1},
+        {"plane", "oblique"},
+        {"plane", 3},
+        {"plane", nullptr},
+        {"point", {1, 2}},
+        {"point", {1, "a", 2}},
+        {"point", nullptr},
+        {"point", {1, 2, 1e300}},
+        {"window", 0},
+        {"window", -4},
+        {"window", "wide"},
+        {"window", nullptr},
+        {"level", "x"},
+        {"level", nullptr},
+        {"interpolation", "cubic"},
+        {"interpolation", nullptr},
+        {"overlay_opacity", 1.5},
+        {"overlay_opacity", -0.1},
+        {"max_size", 0},
+        {"max_size", 100000},
+        {"max_size", 2.5},
+        {"id", -1},
+        {"id", nullptr},
+        {"colour", 1},
     };
     for (const Case& c : cases) {
         json j = slice_json(1);
@@ -139,9 +157,9 @@ TEST(SliceServer, HelloListsTheNewMessages) {
     PhantomServer server;
     Client c(server.port);
     const json hello = c.read_text();
-    EXPECT_EQ(hello["messages"], json::array({"render", "slice", "probe", "screenshot", "session",
-                                              "tf_export", "tf_import", "session_import",
-                                              "volume_frame"}));
+    EXPECT_EQ(hello["messages"],
+              json::array({"render", "slice", "probe", "screenshot", "session", "tf_export",
+                           "tf_import", "session_import", "volume_frame"}));
     EXPECT_EQ(hello["slice_views"]["planes"], json::array({"axial", "coronal", "sagittal"}));
     EXPECT_EQ(hello["slice_views"]["interpolations"], json::array({"trilinear", "nearest"}));
     // The world box the page centres its crosshair in: the phantom's, centred on 0 whatever
@@ -183,7 +201,8 @@ TEST(SliceServer, SliceOverTheWebSocketIsTheLibrarysSliceByteForByte) {
                 o.max_size = server.options.limits.max_side;
                 const Slice s = sample_slice(v, parse_slice_plane(plane), {1.5, -2.0, 3.25}, o);
                 Image img = window_level(s, 180, 90);
-                if (opacity > 0) overlay_labels(img, sample_labels(labels, s.geometry), table, float(opacity));
+                if (opacity > 0)
+                    overlay_labels(img, sample_labels(labels, s.geometry), table, float(opacity));
                 ASSERT_EQ(f.header["width"], s.geometry.width);
                 ASSERT_EQ(f.header["height"], s.geometry.height);
                 EXPECT_EQ(f.jpeg, encode_jpeg(img, server.options.jpeg_quality))
@@ -192,8 +211,10 @@ TEST(SliceServer, SliceOverTheWebSocketIsTheLibrarysSliceByteForByte) {
                 const Vec3d o0{f.header["origin"][0], f.header["origin"][1], f.header["origin"][2]};
                 const Vec3d u{f.header["u"][0], f.header["u"][1], f.header["u"][2]};
                 const Vec3d vv{f.header["v"][0], f.header["v"][1], f.header["v"][2]};
-                const Vec3d corner = o0 + u * double(s.geometry.width - 1) + vv * double(s.geometry.height - 1);
-                const Vec3d want = s.geometry.pixel_world(s.geometry.width - 1, s.geometry.height - 1);
+                const Vec3d corner =
+                    o0 + u * double(s.geometry.width - 1) + vv * double(s.geometry.height - 1);
+                const Vec3d want =
+                    s.geometry.pixel_world(s.geometry.width - 1, s.geometry.height - 1);
                 for (int a = 0; a < 3; ++a) EXPECT_NEAR(corner[a], want[a], 1e-9);
             }
 }

@@ -60,7 +60,8 @@ TEST(VolumeFrameProtocol, ParsesTheFrameAndNamesBadFields) {
             ADD_FAILURE() << bad.dump();
         } catch (const Error& e) {
             const std::string m = e.what();
-            EXPECT_TRUE(m.find("frame") != std::string::npos || m.find("x") != std::string::npos) << m;
+            EXPECT_TRUE(m.find("frame") != std::string::npos || m.find("x") != std::string::npos)
+                << m;
         }
     }
 }

@@ -313,9 +313,9 @@ TEST(MpiRender, LoadFailuresAreOneLineFromRankZero) {
 // counts of composite.cpp equal the model's (composite_model.h). Times are not checked.
 TEST(MpiRender, BenchMpiRunsAndItsCountsAreTheModels) {
     const fs::path out = dir() / "bench";
-    const CliResult r = run_cli("bench mpi --quick --mpirun " + std::string(LACUNA_MPIEXEC) +
-                                    " --out-dir " + out.string(),
-                                dir());
+    const CliResult r = run_cli(
+        "bench mpi --quick --mpirun " + std::string(LACUNA_MPIEXEC) + " --out-dir " + out.string(),
+        dir());
     ASSERT_EQ(r.code, 0) << r.err << r.out;
     const std::string md = slurp_file(out / "mpi.md");
     for (const char* want :
