@@ -132,29 +132,9 @@ Decomposition decompose_voxels(Vec3i dims, int ranks) {
     return decompose(dims, ranks, [](const CellBox& b) { return double(box_volume(b)); });
 }
 
-Decomposition decompose_visible(const Volume& v, const TransferLut& lut, int ranks, int threads) {
-    // Step 1 of the kd-tree paper's table: each row's visible flags summed along x
-    // (as src/accel/kdtree_partition.cpp classify_tf), then Eq. 5 in place.
-    SummedVolumeTable<uint64_t> t;
-    int cells[3];
-    cell_counts(v, cells);
-    t.resize(cells);
-    OpacityPrefix prefix;
-    prefix.build(lut);
-    for_each_cell_row(v, lut.map(), 8, threads, [&](const CellRow& r) {
-        uint64_t* row = t.row(r.j, r.k);
-        uint64_t s = 0;
-        for (int i = 0; i < r.n; ++i) {
-            s += uint64_t(prefix.visible(r.lo[i], r.hi[i]));
-            row[i] = s;
-        }
-    });
-    t.build_from_row_sums();
-    return decompose(v.dims(), ranks, [&t](const CellBox& b) { return double(t.count(b)); });
-}
-
 namespace {
-// Step 1 and Eq. 5 of the kd-tree paper's table over the cells of v (decompose_visible's).
+// Step 1 and Eq. 5 of the kd-tree paper's table over the cells of v: each row's visible flags
+// summed along x (as src/accel/kdtree_partition.cpp classify_tf), then Eq. 5 in place.
 template <class Count>
 void visible_table(const Volume& v, const TransferLut& lut, int threads,
                    SummedVolumeTable<Count>& t) {
@@ -174,6 +154,12 @@ void visible_table(const Volume& v, const TransferLut& lut, int threads,
     t.build_from_row_sums();
 }
 }  // namespace
+
+Decomposition decompose_visible(const Volume& v, const TransferLut& lut, int ranks, int threads) {
+    SummedVolumeTable<uint64_t> t;
+    visible_table(v, lut, threads, t);
+    return decompose(v.dims(), ranks, [&t](const CellBox& b) { return double(t.count(b)); });
+}
 
 SlabCounts::SlabCounts(const Volume& slab, const CellBox& cells, const TransferLut& lut,
                        int threads)
