@@ -29,7 +29,7 @@ dist::Composite parse_composite(const std::string& s) {
 
 }  // namespace
 
-void add_mpi_options(CLI::App& cmd, MpiCliArgs& a) {
+void add_mpi_options(CLI::App& cmd, MpiCliArgs& a, bool rank_times) {
     cmd.add_option("--balance", a.balance,
                    "Under mpirun: kd-tree bricks balanced on voxels, or on the cells the TF can "
                    "make visible (docs/distributed.md)")
@@ -39,8 +39,10 @@ void add_mpi_options(CLI::App& cmd, MpiCliArgs& a) {
            "Under mpirun: sort-last compositing, direct (to rank 0), binary-swap or radix-k "
            "(k = 4)")
         ->capture_default_str();
-    cmd.add_flag("--rank-times", a.rank_times,
-                 "Under mpirun: rank 0 prints each rank's load, build, render and composite times");
+    if (rank_times)
+        cmd.add_flag(
+            "--rank-times", a.rank_times,
+            "Under mpirun: rank 0 prints each rank's load, build, render and composite times");
 }
 
 bool mpi_render_active() {
@@ -52,34 +54,49 @@ void check_mpi_options(const MpiCliArgs& a) {
     parse_composite(a.composite);
 }
 
-void render_mpi(const MpiRenderJob& job) {
-    dist::Comm& comm = dist::Comm::world();
+dist::DistOptions dist_options(const MpiCliArgs& a) {
     dist::DistOptions o;
-    o.balance = parse_balance(job.mpi.balance);
-    o.composite = parse_composite(job.mpi.composite);
-    // What every rank refuses alike, before any rank starts (one line from rank 0, main.cpp).
-    if (job.spec.features.any() || job.spec.two_tfs)
+    o.balance = parse_balance(a.balance);
+    o.composite = parse_composite(a.composite);
+    return o;
+}
+
+void check_distributable(const FrameSpec& spec) {
+    if (spec.renderer != Renderer::RayMarcher)
+        throw Error("mpirun", "renderer", "the ray marcher only (not the slicer or segments)");
+    if (spec.features.any() || spec.two_tfs)
         throw Error("mpirun", "features",
                     "distributed rendering takes no features yet (shading, gradient opacity, "
                     "shadows, clip planes, crop, blend modes, jitter, --tf-back)");
+}
+
+dist::VolumeSource volume_source(const VolumeArgs& v) {
     // Files whose voxels lie at an offset are read by offset (each rank its brick,
     // src/io/brick_read.h), every other file whole by each rank. The header is every rank's
     // alike: its errors (a truncated file) are thrown here, before any rank waits for another.
     ReadOptions ro;
-    ro.raw = job.volume.raw_spec ? job.volume.raw_spec : raw_spec_of(job.volume);
-    ro.frame = job.volume.frame;
-    if (!job.volume.max_memory.empty())
-        ro.max_memory.bytes = parse_bytes(job.volume.max_memory, "--max-memory");
+    ro.raw = v.raw_spec ? v.raw_spec : raw_spec_of(v);
+    ro.frame = v.frame;
+    if (!v.max_memory.empty()) ro.max_memory.bytes = parse_bytes(v.max_memory, "--max-memory");
     ro.max_memory.name = "--max-memory";
-    ro.allow_external_data = job.volume.allow_external_data;
+    ro.allow_external_data = v.allow_external_data;
     dist::VolumeSource source;
-    source.load_whole = [&] { return load_volume(job.volume); };
-    source.file = io::open_brick_file(job.volume.path, ro);
+    source.load_whole = [v] { return load_volume(v); };
+    source.file = io::open_brick_file(v.path, ro);
     source.budget = ro.max_memory;
-    if (job.volume.range_value)
-        source.vis_range = job.volume.range_value;
-    else if (!job.volume.range.empty())
-        source.vis_range = parse_range(job.volume.range);
+    if (v.range_value)
+        source.vis_range = v.range_value;
+    else if (!v.range.empty())
+        source.vis_range = parse_range(v.range);
+    return source;
+}
+
+void render_mpi(const MpiRenderJob& job) {
+    dist::Comm& comm = dist::Comm::world();
+    const dist::DistOptions o = dist_options(job.mpi);
+    // What every rank refuses alike, before any rank starts (one line from rank 0, main.cpp).
+    check_distributable(job.spec);
+    const dist::VolumeSource source = volume_source(job.volume);
     dist::DistFrame f;
     try {
         f = dist::render_distributed(comm, source, job.tf, job.spec, o, job.threads);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli_common.h"
+#include "dist/distributed_frame.h"
 #include "lacuna/frame_spec.h"
 #include "lacuna/transfer_function.h"
 
@@ -14,12 +15,21 @@ struct MpiCliArgs {
     std::string composite = "direct";  // --composite direct|binary-swap
     bool rank_times = false;           // --rank-times: rank 0 prints every rank's times
 };
-void add_mpi_options(CLI::App& cmd, MpiCliArgs& a);
+// rank_times: also --rank-times (render; the viewer has no report to add it to).
+void add_mpi_options(CLI::App& cmd, MpiCliArgs& a, bool rank_times = true);
 // True when this process runs under an MPI launcher in a build with MPI: `render` then renders
 // distributed (the flags are those of one process).
 bool mpi_render_active();
 // Throws lacuna::Error for a --balance/--composite name not in the lists.
 void check_mpi_options(const MpiCliArgs& a);
+
+// The flags' options (check_mpi_options's errors).
+dist::DistOptions dist_options(const MpiCliArgs& a);
+// Throws lacuna::Error for a frame distributed rendering cannot take yet (every rank alike).
+void check_distributable(const FrameSpec& spec);
+// Where the ranks' voxels come from: by offset when the file allows it, else the whole file
+// through load_volume (a header's errors are thrown here, on every rank alike).
+dist::VolumeSource volume_source(const VolumeArgs& v);
 
 struct MpiRenderJob {
     VolumeArgs volume;

@@ -5,7 +5,8 @@
 //
 // MPI is initialised lazily, and only when the process was started by a launcher (mpirun sets
 // OMPI_COMM_WORLD_SIZE, PMI_SIZE or PMIX_RANK): a plain `lacuna render` never touches MPI, and
-// its behaviour is unchanged. Finalised at exit.
+// its behaviour is unchanged. Finalised at exit. Any one thread at a time may call a Comm
+// (MPI_THREAD_SERIALIZED, when the library provides it); the render's worker threads never do.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -43,6 +44,15 @@ class Comm {
     uint64_t sum(uint64_t v);
     // Every rank's `mine` on every rank, in rank order.
     std::vector<uint8_t> allgather(const void* mine, size_t bytes);
+    // A message of any length to `to` alone, and its receipt on `from`'s side (the viewer's
+    // commands, rank_loop.h). await() waits by probing with a sleep of about a millisecond
+    // between probes instead of spinning, so a rank that waits for the next frame leaves its
+    // core to the others (an idle viewer's ranks cost nothing).
+    void post(int to, const std::vector<uint8_t>& bytes);
+    std::vector<uint8_t> await(int from);
+    // Whether any thread may talk to MPI, one at a time (MPI_THREAD_SERIALIZED): the viewer's
+    // rank 0 renders on its render thread. Always true for one process.
+    bool serialized_threads() const { return m_serialized; }
     // Ends every rank of the job with this exit code (after a rank's error: the others may be
     // waiting in a collective).
     [[noreturn]] void abort(int code);
@@ -50,6 +60,7 @@ class Comm {
   private:
     Comm();
     int m_rank = 0, m_size = 1;
+    bool m_serialized = true;
 };
 
 }  // namespace lacuna::dist

@@ -3,6 +3,7 @@
 #define OMPI_SKIP_MPICXX 1
 #define MPICH_SKIP_MPICXX 1
 #include <mpi.h>
+#include <time.h>
 
 #include <climits>
 #include <cstdlib>
@@ -46,10 +47,14 @@ Comm::Comm() {
     MPI_Initialized(&init);
     if (!init) {
         int provided = 0;
-        // Only the thread that called world() talks to MPI (the render's worker threads never do).
-        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+        // One thread at a time talks to MPI: the CLI's main thread, or the viewer's render
+        // thread on rank 0 (the render's worker threads never do).
+        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
         std::atexit(finalize_at_exit);
     }
+    int level = MPI_THREAD_SINGLE;
+    MPI_Query_thread(&level);
+    m_serialized = level >= MPI_THREAD_SERIALIZED;
     MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &m_size);
 }
@@ -131,6 +136,29 @@ std::vector<uint8_t> Comm::allgather(const void* mine, size_t bytes) {
     std::vector<uint8_t> all(bytes * size_t(m_size));
     MPI_Allgather(mine, int(bytes), MPI_BYTE, all.data(), int(bytes), MPI_BYTE, MPI_COMM_WORLD);
     return all;
+}
+
+// The tag of post/await, apart from every compositing round's.
+constexpr int kPostTag = 0x7A11;
+
+void Comm::post(int to, const std::vector<uint8_t>& bytes) {
+    if (bytes.size() > size_t(INT_MAX)) throw Error("mpi", "post", "expected under 2 GiB");
+    MPI_Send(bytes.data(), int(bytes.size()), MPI_BYTE, to, kPostTag, MPI_COMM_WORLD);
+}
+
+std::vector<uint8_t> Comm::await(int from) {
+    MPI_Status st;
+    for (int arrived = 0;;) {
+        MPI_Iprobe(from, kPostTag, MPI_COMM_WORLD, &arrived, &st);
+        if (arrived) break;
+        const timespec ms{0, 1000000};
+        nanosleep(&ms, nullptr);
+    }
+    int n = 0;
+    MPI_Get_count(&st, MPI_BYTE, &n);
+    std::vector<uint8_t> bytes(size_t(n < 0 ? 0 : n));
+    MPI_Recv(bytes.data(), n, MPI_BYTE, from, kPostTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    return bytes;
 }
 
 void Comm::abort(int code) {

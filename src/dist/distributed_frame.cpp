@@ -59,11 +59,13 @@ int rank_threads(int requested) {
     return resolve_threads(0);
 }
 
-DistFrame render_distributed(Comm& comm, const VolumeSource& source, const TransferFunction& tf,
-                             const FrameSpec& spec, const DistOptions& options, int threads) {
-    threads = rank_threads(threads);
-    DistFrame out;
-    RankReport me;
+DistributedSession::DistributedSession(Comm& comm, const VolumeSource& source,
+                                       const TransferFunction& tf, const DistOptions& options,
+                                       int threads)
+    : m_comm(comm), m_options(options), m_threads(rank_threads(threads)) {
+    threads = m_threads;
+    DistFrame out;  // its decomposition and whole_voxels, kept as the members below
+    RankReport& me = m_loaded;
     me.rank = comm.rank();
     // 1. The whole grid, its decomposition, this rank's brick.
     auto t0 = Clock::now();
@@ -161,17 +163,54 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
     }
     me.load_seconds = seconds_since(t0);
     me.voxels = brick.voxel_count();
-    // 2. The brick's session: its structure, then its owned samples.
-    std::optional<Session> session;
+    m_decomposition = std::move(out.decomposition);
+    m_whole_voxels = out.whole_voxels;
+    m_own = own;
+    m_whole_bounds = whole_bounds;
+    // 2 (once). The brick's session; its structures are built by the first frame.
+    try {
+        m_session = std::make_unique<Session>(std::move(brick), threads);
+        m_session->set_brick(own, whole_bounds);
+    } catch (const std::exception& e) {
+        failed = std::current_exception();
+        what = e.what();
+    }
+    agree(comm, failed, what);
+}
+
+DistributedSession::~DistributedSession() = default;
+
+void DistributedSession::refine() {
+    std::exception_ptr failed;
+    std::string what;
+    try {
+        m_session->refine();
+    } catch (const std::exception& e) {
+        failed = std::current_exception();
+        what = e.what();
+    }
+    agree(m_comm, failed, what);
+}
+
+DistFrame DistributedSession::render(const TransferFunction& tf, const FrameSpec& spec,
+                                     bool refine) {
+    Comm& comm = m_comm;
+    Session* session = m_session.get();
+    DistFrame out;
+    out.decomposition = m_decomposition;
+    out.whole_voxels = m_whole_voxels;
+    RankReport me = m_loaded;
     FrameSpec f = spec;
     f.keep_float = true;
-    t0 = Clock::now();
+    f.sampling.early_termination.reset();  // a rank cannot see the opacity in front of its brick
+    std::exception_ptr failed;
+    std::string what;
+    // 2. The brick's structure for this frame's TF.
+    const auto t0 = Clock::now();
     try {
-        session.emplace(std::move(brick), threads);
-        session->set_brick(own, whole_bounds);
         session->set_transfer_function(tf);
         session->prepare(f);
-        session->refine();
+        if (refine) session->refine();
     } catch (const std::exception& e) {
         failed = std::current_exception();
         what = e.what();
@@ -201,7 +240,7 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
         Partial mine{f.width, f.height, std::move(r.rgba_float)};
         CompositeStats cs;
         Partial done;
-        switch (options.composite) {
+        switch (m_options.composite) {
             case Composite::Direct:
                 done = composite_direct(comm, mine,
                                         visibility_order(out.decomposition, eye, dir, ortho), cs);
@@ -212,7 +251,7 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
                 break;
             case Composite::RadixK:
                 done = composite_radix_k(comm, std::move(mine), out.decomposition, eye, dir, ortho,
-                                         options.radix, cs);
+                                         m_options.radix, cs);
                 break;
         }
         if (f.count_samples) {
@@ -246,6 +285,12 @@ DistFrame render_distributed(Comm& comm, const VolumeSource& source, const Trans
         throw RankFailure("rank " + std::to_string(comm.rank()) + ": " + e.what());
     }
     return out;
+}
+
+DistFrame render_distributed(Comm& comm, const VolumeSource& source, const TransferFunction& tf,
+                             const FrameSpec& spec, const DistOptions& options, int threads) {
+    DistributedSession session(comm, source, tf, options, threads);
+    return session.render(tf, spec, /*refine=*/true);
 }
 
 }  // namespace lacuna::dist

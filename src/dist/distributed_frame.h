@@ -17,6 +17,7 @@
 // to the float association of compositing (within 1/255 per channel; tests/dist/).
 #pragma once
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -28,6 +29,7 @@
 #include "lacuna/frame_spec.h"
 #include "lacuna/image.h"
 #include "lacuna/renderer.h"
+#include "lacuna/session.h"
 #include "lacuna/transfer_function.h"
 #include "lacuna/volume.h"
 
@@ -93,7 +95,46 @@ struct RankFailure : Error {
     using Error::Error;
 };
 
-// `threads` as rank_threads() resolves it.
+// A job's bricks kept across frames (the viewer under mpirun, src/dist/rank_loop.h): step 1
+// once, when constructed; steps 2 and 3 per frame. Every rank constructs it with the same
+// arguments and then calls render() and refine() with the same TF and spec in the same order.
+// With Balance::Visible the bricks are balanced on the constructor's TF and kept for every
+// later TF: a frame of another TF is as exact, only less balanced.
+class DistributedSession {
+  public:
+    // `threads` as rank_threads() resolves it. Failures are agreed as in render_distributed.
+    DistributedSession(Comm& comm, const VolumeSource& source, const TransferFunction& tf,
+                       const DistOptions& options, int threads);
+    ~DistributedSession();
+    DistributedSession(const DistributedSession&) = delete;
+    DistributedSession& operator=(const DistributedSession&) = delete;
+
+    // Steps 2 and 3 for one frame (spec's early termination ignored: see the top). With `refine`
+    // the structure's per-TF refinement (Session::refine) is computed before the frame (one
+    // frame of the CLI; the viewer refines between frames). A failure every rank learns before
+    // rendering (a spec the session refuses) is thrown as lacuna::Error on every rank and leaves
+    // the session usable; a rank's own failure while rendering or compositing is a RankFailure.
+    DistFrame render(const TransferFunction& tf, const FrameSpec& spec, bool refine = false);
+    // Session::refine on every rank's brick.
+    void refine();
+
+    Comm& comm() const { return m_comm; }
+    const Decomposition& decomposition() const { return m_decomposition; }
+    int threads() const { return m_threads; }
+
+  private:
+    Comm& m_comm;
+    DistOptions m_options;
+    int m_threads;
+    Decomposition m_decomposition;
+    BrickOwnership m_own;
+    Box3f m_whole_bounds;
+    uint64_t m_whole_voxels = 0;
+    RankReport m_loaded;                 // load_seconds, voxels, voxels_read
+    std::unique_ptr<Session> m_session;  // over the brick
+};
+
+// One frame: a DistributedSession for it, refined, rendered. `threads` as rank_threads().
 DistFrame render_distributed(Comm& comm, const VolumeSource& source, const TransferFunction& tf,
                              const FrameSpec& spec, const DistOptions& options, int threads);
 

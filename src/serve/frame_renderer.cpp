@@ -180,7 +180,10 @@ ViewRequest FrameRenderer::view_request(const FrameSpec& f, const TransferFuncti
 }
 
 void FrameRenderer::refine() {
-    m_session->refine();
+    if (m_source)
+        m_source->refine();
+    else
+        m_session->refine();
 }
 
 Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
@@ -193,7 +196,7 @@ Frame FrameRenderer::render(const ViewRequest& req, int width, int height) {
     f.tf_changed = m_session->set_transfer_function(req.tf);
     const double lut_seconds = seconds_since(t0);
     // 2. The frame (building its structure the first time one is asked for).
-    FrameResult r = m_session->render(spec);
+    FrameResult r = m_source ? m_source->render(req.tf, spec) : m_session->render(spec);
     if (f.tf_changed) f.tf_update_seconds = lut_seconds + r.tf_sync_seconds;
     f.accel_build_seconds = r.build_seconds;
     if (r.structure) f.accel_tf_update_seconds = r.structure->tf_update_seconds;

@@ -32,6 +32,19 @@ struct Frame {
     double accel_tf_update_seconds = 0;  // the structure's last TF update (AccelStats)
 };
 
+// Where the frames come from when not from the renderer's own session: under `mpirun -np N
+// lacuna serve` every rank renders its brick of each frame (apps/lacuna/serve_mpi.cpp over
+// src/dist/). The renderer's session still answers slices and probes, holds the histogram and
+// counts the reference lattice; the source renders the frames and refines its structures.
+class FrameSource {
+  public:
+    virtual ~FrameSource() = default;
+    // The frame of `spec` under `tf` (Error for one the source cannot render: the page's error
+    // message).
+    virtual FrameResult render(const TransferFunction& tf, const FrameSpec& spec) = 0;
+    virtual void refine() = 0;
+};
+
 class FrameRenderer {
   public:
     // threads: render and build threads (0 = all). The renderer keeps the volume.
@@ -55,6 +68,9 @@ class FrameRenderer {
     // Voxel counts in kHistogramBins equal bins over the visualization range.
     static constexpr int kHistogramBins = 256;
     const std::vector<uint64_t>& histogram() const { return m_histogram; }
+
+    // Frames from `source` from now on (nullptr: from the session again).
+    void set_frame_source(std::unique_ptr<FrameSource> source) { m_source = std::move(source); }
 
     // Renders `req` at width x height (the server passes a reduced size for previews).
     Frame render(const ViewRequest& req, int width, int height);
@@ -91,6 +107,7 @@ class FrameRenderer {
     AccelOptions m_accel_options;  // the structures' parameters (--leaf, --bits of `lacuna serve`)
     int m_threads;
     std::vector<uint64_t> m_histogram;
+    std::unique_ptr<FrameSource> m_source;
 };
 
 }  // namespace lacuna::serve
