@@ -505,12 +505,18 @@ void render_frames(RenderArgs& a, const Setup& s) {
         case Renderer::RayMarcher:
             if (mpi_render_active()) {
                 // Under mpirun: one frame by every rank (render_mpi.h).
-                if (a.orbit || !a.tf_animate.empty() || a.repeat != 1 || !a.movie.empty())
+                if (!a.tf_animate.empty() || !a.movie.empty())
                     throw Error("mpirun", "frames",
-                                "one frame per run under mpirun (not --orbit, --tf-animate, "
-                                "--repeat or --movie yet)");
-                render_mpi(
-                    {a.volume, front_tf(a), accel, a.out, a.heatmap, a.threads, s.spec, a.mpi});
+                                "--orbit and --repeat under mpirun, not --tf-animate or --movie "
+                                "yet");
+                MpiRenderJob job{a.volume,  front_tf(a), accel,  a.out,
+                                 a.heatmap, a.threads,   s.spec, a.mpi};
+                for (int i = 0; i < a.orbit; ++i) {
+                    job.azimuths.push_back(orbit_azimuth(a.azimuth, i, a.orbit));
+                    if (!a.out.empty()) job.outs.push_back(frame_path(a.out, i, a.orbit));
+                }
+                job.repeat = a.repeat;
+                render_mpi(job);
                 return;
             }
             if (a.orbit)

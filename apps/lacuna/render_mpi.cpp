@@ -64,10 +64,12 @@ dist::DistOptions dist_options(const MpiCliArgs& a) {
 void check_distributable(const FrameSpec& spec) {
     if (spec.renderer != Renderer::RayMarcher)
         throw Error("mpirun", "renderer", "the ray marcher only (not the slicer or segments)");
-    if (spec.features.any() || spec.two_tfs)
+    // Shading, gradient opacity, clip planes, crop and jitter act on each sample alone; shadows
+    // reach into other bricks, and the other blend modes and a back TF composite differently.
+    const FeatureOptions& f = spec.features;
+    if (f.shadows.enabled || f.blend != BlendMode::Composite || spec.two_tfs)
         throw Error("mpirun", "features",
-                    "distributed rendering takes no features yet (shading, gradient opacity, "
-                    "shadows, clip planes, crop, blend modes, jitter, --tf-back)");
+                    "distributed rendering takes no shadows, blend modes or --tf-back yet");
 }
 
 dist::VolumeSource volume_source(const VolumeArgs& v) {
@@ -97,9 +99,43 @@ void render_mpi(const MpiRenderJob& job) {
     // What every rank refuses alike, before any rank starts (one line from rank 0, main.cpp).
     check_distributable(job.spec);
     const dist::VolumeSource source = volume_source(job.volume);
-    dist::DistFrame f;
+    // Rank 0 alone writes; a failed write there ends the job (the others may already wait in
+    // the next frame's messages).
+    auto write_or_end = [&](const std::string& path, const Image& image) {
+        try {
+            write_png(path, image);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "lacuna: %s\n", e.what());
+            comm.abort(2);
+        }
+    };
+    dist::DistFrame f;  // the frame the report describes
+    double orbit_seconds = 0;
     try {
-        f = dist::render_distributed(comm, source, job.tf, job.spec, o, job.threads);
+        dist::DistributedSession session(comm, source, job.tf, o, job.threads);
+        if (!job.azimuths.empty()) {
+            // --orbit: every frame from the same bricks and structures.
+            FrameSpec spec = job.spec;
+            for (size_t i = 0; i < job.azimuths.size(); ++i) {
+                spec.camera.orbit.azimuth_deg = job.azimuths[i];
+                f = session.render(job.tf, spec, /*refine=*/i == 0);
+                orbit_seconds += f.frame_seconds;
+                if (comm.rank() == 0 && i < job.outs.size()) write_or_end(job.outs[i], f.image);
+            }
+        } else {
+            f = session.render(job.tf, job.spec, /*refine=*/true);
+            // --repeat N: frame 1 warms caches, pages and threads; the report is the median of
+            // the N - 1 frames after it by rank 0's frame time (every frame the same bytes).
+            std::vector<dist::DistFrame> warm;
+            for (int r = 1; r < job.repeat; ++r) warm.push_back(session.render(job.tf, job.spec));
+            if (!warm.empty()) {
+                std::sort(warm.begin(), warm.end(),
+                          [](const dist::DistFrame& a, const dist::DistFrame& b) {
+                              return a.frame_seconds < b.frame_seconds;
+                          });
+                f = std::move(warm[warm.size() / 2]);
+            }
+        }
     } catch (const dist::RankFailure& e) {
         // One rank's own failure while rendering: the others may wait for its messages, so the
         // job ends here with the CLI's exit code for errors.
@@ -107,7 +143,7 @@ void render_mpi(const MpiRenderJob& job) {
         comm.abort(2);
     }
     if (comm.rank() != 0) return;
-    write_png(job.out, f.image);
+    if (job.azimuths.empty()) write_png(job.out, f.image);
     if (!job.heatmap.empty())
         write_png(job.heatmap, heatmap(f.sample_counts, job.spec.width, job.spec.height));
     const FrameSpec& s = job.spec;
@@ -128,6 +164,12 @@ void render_mpi(const MpiRenderJob& job) {
         std::printf(
             "early ray termination: off (a rank cannot see the opacity in front of its brick)\n");
     std::printf("bricks: %s\n", dist::to_string(f.decomposition).c_str());
+    if (!job.azimuths.empty())
+        std::printf("orbit of %zu frames, frame time %.1f ms (mean); the last frame:\n",
+                    job.azimuths.size(), orbit_seconds / double(job.azimuths.size()) * 1e3);
+    else if (job.repeat > 1)
+        std::printf("%d frames; the median of the %d after the first:\n", job.repeat,
+                    job.repeat - 1);
     std::printf(
         "frame %.1f ms (slowest rank's render %.1f ms), %llu samples, %.1f MiB composited\n",
         f.frame_seconds * 1e3, slowest * 1e3, (unsigned long long)samples,
@@ -146,7 +188,10 @@ void render_mpi(const MpiRenderJob& job) {
                 double(r.bytes_sent) / 1024, double(r.peak_rss_kib) / 1024);
     }
     if (!job.heatmap.empty()) std::printf("wrote %s\n", job.heatmap.c_str());
-    std::printf("wrote %s\n", job.out.c_str());
+    if (!job.outs.empty())
+        std::printf("wrote %s .. %s\n", job.outs.front().c_str(), job.outs.back().c_str());
+    else if (job.azimuths.empty())
+        std::printf("wrote %s\n", job.out.c_str());
     std::fflush(stdout);
 }
 

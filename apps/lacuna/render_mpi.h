@@ -2,6 +2,7 @@
 // docs/distributed.md). Kept out of cmd_render.cpp so the single-process path stays as it was.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "cli_common.h"
 #include "dist/distributed_frame.h"
@@ -39,8 +40,13 @@ struct MpiRenderJob {
     int threads = 0;
     FrameSpec spec;
     MpiCliArgs mpi;
+    // --orbit N: frame i at azimuths[i], written to outs[i] (empty: the one frame of `spec` to
+    // `out`). The bricks and their structures are made once for all frames.
+    std::vector<float> azimuths;
+    std::vector<std::string> outs;
+    int repeat = 1;  // --repeat: the report's times are the median of the frames after the first
 };
-// Rank 0 writes the PNG and the report; the others write nothing.
+// Rank 0 writes the PNGs and the report; the others write nothing.
 void render_mpi(const MpiRenderJob& job);
 
 }  // namespace lacuna::cli

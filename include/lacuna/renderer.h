@@ -145,8 +145,10 @@ inline constexpr float kNoEarlyTermination = 2.f;
 // p = o + t_k * d, before the clamp) has lo[a] <= p[a] < hi[a] on every axis; the bricks' owned
 // boxes partition space (the outer faces are -inf / +inf), so every sample of the single-process
 // image is taken by exactly one rank. The brick must hold the voxels [lo, hi] of each finite bound
-// (the cells an owned sample interpolates in). Early ray termination is off on this path (a rank
-// cannot know the opacity in front of its brick), and no features are taken yet.
+// (the cells an owned sample interpolates in), and [lo - 1, hi + 1] for gradients (shading,
+// gradient opacity: their central differences). Early ray termination is off on this path (a
+// rank cannot know the opacity in front of its brick); features that act on each sample alone
+// are taken, not shadows, blend modes other than composite, or two TFs.
 struct BrickOwnership {
     Vec3i whole_dims{0, 0, 0};                   // the whole grid's voxels per axis
     Vec3i offset{0, 0, 0};                       // whole-grid index of the brick's voxel (0, 0, 0)

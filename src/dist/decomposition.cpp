@@ -161,9 +161,13 @@ Decomposition decompose_visible(const Volume& v, const TransferLut& lut, int ran
     return decompose(v.dims(), ranks, [&t](const CellBox& b) { return double(t.count(b)); });
 }
 
-SlabCounts::SlabCounts(const Volume& slab, const CellBox& cells, const TransferLut& lut,
-                       int threads)
-    : m_cells(cells), m_narrow(uint64_t(box_volume(cells)) < (uint64_t(1) << 32)) {
+SlabCounts::SlabCounts(const Volume& slab, Vec3i offset, const CellBox& cells,
+                       const TransferLut& lut, int threads)
+    : m_cells(cells),
+      m_offset(offset),
+      m_narrow(uint64_t(slab.dims().x - 1) * uint64_t(slab.dims().y - 1) *
+                   uint64_t(slab.dims().z - 1) <
+               (uint64_t(1) << 32)) {
     if (m_narrow)
         visible_table(slab, lut, threads, m_t32);
     else
@@ -171,10 +175,10 @@ SlabCounts::SlabCounts(const Volume& slab, const CellBox& cells, const TransferL
 }
 
 uint64_t SlabCounts::count(const CellBox& b) const {
-    CellBox c;  // b within this slab, in slab cells
+    CellBox c;  // b within this slab's own cells, in slab cells
     for (int a = 0; a < 3; ++a) {
-        c.lo[a] = std::max(b.lo[a], m_cells.lo[a]) - m_cells.lo[a];
-        c.hi[a] = std::min(b.hi[a], m_cells.hi[a]) - m_cells.lo[a];
+        c.lo[a] = std::max(b.lo[a], m_cells.lo[a]) - m_offset[a];
+        c.hi[a] = std::min(b.hi[a], m_cells.hi[a]) - m_offset[a];
         if (c.lo[a] >= c.hi[a]) return 0;
     }
     return m_narrow ? uint64_t(m_t32.count(c)) : uint64_t(m_t64.count(c));
@@ -190,7 +194,7 @@ BrickOwnership ownership(const Decomposition& d, int rank) {
     const int cells[3] = {d.dims.x - 1, d.dims.y - 1, d.dims.z - 1};
     BrickOwnership o;
     o.whole_dims = d.dims;
-    o.offset = {c.lo[0], c.lo[1], c.lo[2]};
+    o.offset = {std::max(c.lo[0] - 1, 0), std::max(c.lo[1] - 1, 0), std::max(c.lo[2] - 1, 0)};
     for (int a = 0; a < 3; ++a) {
         o.lo[a] = c.lo[a] == 0 ? -INFINITY : float(c.lo[a]);
         o.hi[a] = c.hi[a] == cells[a] ? INFINITY : float(c.hi[a]);
@@ -200,7 +204,10 @@ BrickOwnership ownership(const Decomposition& d, int rank) {
 
 Vec3i brick_voxels(const Decomposition& d, int rank) {
     const CellBox& c = d.bricks.at(size_t(rank));
-    return {c.hi[0] - c.lo[0] + 1, c.hi[1] - c.lo[1] + 1, c.hi[2] - c.lo[2] + 1};
+    const Vec3i o = ownership(d, rank).offset;
+    return {std::min(c.hi[0] + 1, d.dims.x - 1) - o.x + 1,
+            std::min(c.hi[1] + 1, d.dims.y - 1) - o.y + 1,
+            std::min(c.hi[2] + 1, d.dims.z - 1) - o.z + 1};
 }
 
 bool low_in_front(const KdNode& n, Vec3f eye, Vec3f dir, bool orthographic) {

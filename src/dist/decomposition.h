@@ -5,8 +5,11 @@
 // In index space that leaf owns the half-open box [lo, hi) of positions (BrickOwnership,
 // lacuna/renderer.h), with -inf / +inf on the faces that are the grid's own, so the owned boxes
 // partition space and every lattice sample has exactly one owner (render/ownership.h). A rank
-// reads the voxels [lo, hi] of its cells (hi included: the one-voxel ghost layer on each high
-// face that cells [hi - 1, hi) interpolate to).
+// reads the voxels [lo - 1, hi + 1] of its cells, clamped to the grid: [lo, hi] is what its
+// owned samples interpolate (hi included: cells [hi - 1, hi) interpolate to voxel hi), and the
+// ghost voxels lo - 1 and hi + 1 are what the central differences of the gradients at voxels lo
+// and hi read (shading, gradient opacity: src/render/feature_kernel.h), so a brick's gradients
+// at every voxel its samples interpolate are the whole volume's, bit for bit.
 //
 // Balance. Each split puts the fraction of the node's weight that its two subtrees' leaf counts
 // ask for on each side, along the node's longest axis: weight = cells (--balance voxels), or
@@ -84,13 +87,16 @@ Decomposition decompose_visible(const Volume& v, const TransferLut& lut, int ran
 // (cell_ranges.h), which can move a cell within ulps of a TF edge, and so a plane.
 class SlabCounts {
   public:
-    SlabCounts(const Volume& slab, const CellBox& cells, const TransferLut& lut, int threads);
+    // `slab`: the voxels ownership(d, r).offset + [0, brick_voxels(d, r)) of `cells`' brick.
+    SlabCounts(const Volume& slab, Vec3i offset, const CellBox& cells, const TransferLut& lut,
+               int threads);
     // Visible cells of the whole-grid box `b` inside this slab.
     uint64_t count(const CellBox& b) const;
     size_t bytes() const { return m_t32.bytes() + m_t64.bytes(); }
 
   private:
     CellBox m_cells;
+    Vec3i m_offset;  // the slab's voxel (0, 0, 0) in the whole grid
     bool m_narrow;
     SummedVolumeTable<uint32_t> m_t32;  // when the slab's cells fit 32 bits (the table's rule)
     SummedVolumeTable<uint64_t> m_t64;
@@ -98,7 +104,8 @@ class SlabCounts {
 Decomposition decompose_visible_slabs(Vec3i dims, const SlabCounts& mine, int ranks,
                                       const std::function<uint64_t(uint64_t)>& sum);
 
-// The owned box of `rank` and the voxels it reads: offset = brick.lo, dims = brick.hi - lo + 1.
+// The owned box of `rank` and the voxels it reads: offset = max(brick.lo - 1, 0), up to and
+// including min(brick.hi + 1, dims - 1) (the ghost layer above).
 BrickOwnership ownership(const Decomposition& d, int rank);
 Vec3i brick_voxels(const Decomposition& d, int rank);
 

@@ -128,7 +128,7 @@ DistributedSession::DistributedSession(Comm& comm, const VolumeSource& source,
             vis = source.vis_range ? *source.vis_range : default_vis_range(lo, hi);
             finish(brick);
             if (visible)
-                counts.emplace(brick, out.decomposition.bricks[size_t(comm.rank())],
+                counts.emplace(brick, own.offset, out.decomposition.bricks[size_t(comm.rank())],
                                discretise(tf, vis), threads);
         } catch (const std::exception& e) {
             failed = std::current_exception();

@@ -37,6 +37,7 @@
 #include "lacuna/image.h"
 #include "lacuna/renderer.h"
 #include "render/lane_scheduler.h"
+#include "render/ownership.h"
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 #include "render/shading.h"
@@ -91,6 +92,10 @@ struct Context {
     Vec3f light_dir{0, 0, 1};   // directional: unit vector to the light
     Vec3f spot_axis{0, 0, -1};  // spot: unit vector from the light to its target
     int threads = 0;
+    // Distributed rendering (lacuna/renderer.h BrickOwnership): the owned samples only, the grid
+    // the whole grid seen through the brick's voxels (render/ownership.h brick_grid), the
+    // structure walked in brick index space. Null: the whole volume.
+    const BrickOwnership* brick = nullptr;
 
     bool kept(float x, float y, float z) const {
         for (int i = 0; i < n_clips; ++i)
@@ -132,10 +137,15 @@ inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x
         z = float(int(std::clamp(z, 0.f, g.hi_z) + 0.5f));
     }
     if (c.grad[0]) {
-        const int m[3] = {int(g.hi_x) + 1, int(g.hi_y) + 1, int(g.hi_z) + 1};
-        return {kernel::trilinear(float_grid(c.grad[0], m), x, y, z),
-                kernel::trilinear(float_grid(c.grad[1], m), x, y, z),
-                kernel::trilinear(float_grid(c.grad[2], m), x, y, z)};
+        // The gradient volume is laid out as the voxels are (with a brick's strides and moved
+        // pointer under distributed rendering): the voxels' grid with its data swapped.
+        auto of = [&](const float* d) {
+            return kernel::Grid<float, int64_t>{d,      g.sy,     g.sz,     g.hi_x,  g.hi_y,
+                                                g.hi_z, g.cell_x, g.cell_y, g.cell_z};
+        };
+        return {kernel::trilinear(of(c.grad[0]), x, y, z),
+                kernel::trilinear(of(c.grad[1]), x, y, z),
+                kernel::trilinear(of(c.grad[2]), x, y, z)};
     }
     // The voxels' central differences, interpolated at the sample (core/gradient.h).
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z}, isp[3] = {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z};
@@ -245,10 +255,11 @@ struct Counts {
 template <class T, class Index, class S, class Cursor>
 inline uint32_t composite_ray(const Context& c, const kernel::Grid<T, Index>& g, const S& accel,
                               Cursor& cursor, const kernel::IndexRay& r, Vec3f view, float t_base,
-                              int k_end, kernel::Accum& acc, uint64_t& shadow_n) {
+                              int k_end, kernel::Accum& acc, uint64_t& shadow_n, int k_begin = 0) {
     const FeatureOptions& f = *c.f;
     uint32_t n = 0;
     for_each_sample(cursor, t_base, c.dt, k_end, [&](int k) {
+        if (k < k_begin) return true;  // a brick's: before its owned run
         // 1. Position; clipped samples are not taken.
         const float t = t_base + (float(k) + 0.5f) * c.dt;
         const float x = r.ox + t * r.dx, y = r.oy + t * r.dy, z = r.oz + t * r.dz;
@@ -745,9 +756,22 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                 ++counts.rays;
                 const float j = f.jitter ? jitter(uint32_t(px), uint32_t(py), f.jitter_seed) : 0.5f;
                 const float t_base = t_near + (j - 0.5f) * c.dt;
-                const int k_end = lattice_end(t_base, t_far, c.dt);
-                const IndexRay& cr = r;
-                if (f.blend == BlendMode::Mip || f.blend == BlendMode::MinIp) {
+                int k_begin = 0, k_end = lattice_end(t_base, t_far, c.dt);
+                IndexRay cr = r;
+                float c0 = t_near, c1 = t_far;
+                if (c.brick) {
+                    // A brick's owned run of the lattice; its structure walks the ray in brick
+                    // index space over the run and a sample of margin each side, the runs are
+                    // clipped to it (render_tile_brick's steps, ray_marcher.cpp).
+                    owned_run(r, t_base, c.dt, k_end, c.brick->lo, c.brick->hi, k_begin, k_end);
+                    cr.ox -= float(c.brick->offset.x), cr.oy -= float(c.brick->offset.y);
+                    cr.oz -= float(c.brick->offset.z);
+                    c0 = std::max(t_near, t_base + (float(k_begin) - 0.5f) * c.dt);
+                    c1 = std::min(t_far, t_base + (float(k_end) + 0.5f) * c.dt);
+                }
+                if (k_begin >= k_end) {
+                    // no owned sample (a brick's ray)
+                } else if (f.blend == BlendMode::Mip || f.blend == BlendMode::MinIp) {
                     const bool maximum = f.blend == BlendMode::Mip;
                     int lo = 0, hi_e = c.map.last();
                     bool done = false;
@@ -767,19 +791,21 @@ void render_tile(const Context& c, const S& accel, const kernel::Grid<T, Index>&
                     }
                 } else {
                     typename S::Cursor cursor(
-                        accel, cr, t_near, t_far, c.dt,
+                        accel, cr, c0, c1, c.dt,
                         f.blend == BlendMode::Composite && c.ert < 1.f ? chunk : 0.f);
                     if (f.blend == BlendMode::Average) {
                         n = average_ray(c, g, cursor, r, t_base, k_end, acc);
                     } else if constexpr (!std::is_void_v<Ops>) {
                         ShadedStream<T, Ops> stream(c, g.data, sg, r, view, t_base, acc);
-                        for_each_lattice_run(cursor, t_base, c.dt, k_end,
-                                             [&](int kb, int ke) { return stream.add(kb, ke); });
+                        for_each_lattice_run(cursor, t_base, c.dt, k_end, [&](int kb, int ke) {
+                            kb = std::max(kb, k_begin);
+                            return ke > kb ? stream.add(kb, ke) : true;
+                        });
                         stream.finish();
                         n = stream.samples();
                     } else {
                         n = composite_ray(c, g, accel, cursor, r, view, t_base, k_end, acc,
-                                          counts.shadow);
+                                          counts.shadow, k_begin);
                     }
                 }
             }

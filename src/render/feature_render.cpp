@@ -12,6 +12,7 @@
 #include "lacuna/renderer.h"
 #include "render/feature_kernel.h"
 #include "render/marcher_cache.h"
+#include "render/ownership.h"
 
 namespace lacuna {
 
@@ -147,6 +148,12 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
     c.map = m_lut.map();
     c.two_tfs = two_tfs;
     c.threads = opt.threads;
+    // Distributed rendering: a brick's owned samples (feature::Context::brick). Its voxel offsets
+    // are whole-grid offsets from a moved pointer (render/ownership.h brick_grid), so the lane
+    // paths' int32 offsets must hold the brick's last voxel counted from there.
+    const BrickOwnership* brick = opt.brick ? &*opt.brick : nullptr;
+    c.brick = brick;
+    const ptrdiff_t shift = brick ? brick_shift(*brick, m_volume.dims()) : 0;
 
     // 2. Geometry in index space.
     const Vec3d& s = m_volume.spacing;
@@ -191,7 +198,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             out.stats.gradient_volume_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }
-        for (int a = 0; a < 3; ++a) c.grad[a] = m_cache->grad[a].data();
+        for (int a = 0; a < 3; ++a) c.grad[a] = shift_to_whole(m_cache->grad[a].data(), shift);
         out.stats.gradient_volume_bytes = 3 * m_cache->grad[0].size() * sizeof(float);
     }
 
@@ -202,7 +209,8 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
     visit_voxels(m_volume, [&](const auto* data) {
         using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
         // The feature path always indexes with int64 (it is not the hot path for huge grids).
-        const kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, d);
+        const kernel::Grid<T, int64_t> g =
+            brick ? brick_grid(data, d, *brick) : kernel::make_grid<int64_t>(data, d);
         static const NoAccel kNone;
         visit_accel(m_accel ? *m_accel : kNone, [&](const auto& acc) {
             // 4. The light volume, when the light, TF or clipping changed since it was made.
@@ -234,16 +242,20 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             // 5. The frame: composite rays without shadows or gradient opacity on the batched SIMD
             // path of the active ISA (int32 offsets: grids under 2^31 voxels), the rest one sample
             // at a time (feature::composite_ray, the reference; also the scalar ISA path).
-            const int dims[3] = {d.x, d.y, d.z};
+            const Vec3i w = brick ? brick->whole_dims : d;  // the grid the rays sample
+            const int dims[3] = {w.x, w.y, w.z};
             simd::ShadeGrid sg = feature::shade_grid(c, dims);
+            sg.sy = int32_t(g.sy), sg.sz = int32_t(g.sz);  // a brick's strides (else the same)
             // The structure's visible-cell mask (refined grids), for the plain batched case: one
-            // TF (the structure's), no clip planes or crop box, trilinear samples.
+            // TF (the structure's), no clip planes or crop box, trilinear samples (not a brick's:
+            // its cells are in brick index space).
             if constexpr (requires { acc.cell_mask(); })
-                if (!c.nearest && !c.two_tfs && c.n_clips == 0 && !f.crop)
+                if (!c.nearest && !c.two_tfs && c.n_clips == 0 && !f.crop && !brick)
                     sg.cell_mask = acc.cell_mask();
             // Nearest sampling runs the reference too (one path for every ISA, so still exact).
             const bool batched = composite && !f.shadows.enabled && !f.gradient_opacity.enabled &&
-                                 !c.nearest && m_volume.voxel_count() < (size_t(1) << 31);
+                                 !c.nearest &&
+                                 size_t(shift) + m_volume.voxel_count() < (size_t(1) << 31);
             auto frame = [&](auto ops) {
                 using Ops = typename decltype(ops)::type;
                 parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
@@ -263,7 +275,7 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
             // ShadedStream).
             if constexpr (std::is_same_v<std::decay_t<decltype(acc)>, BrickGrid>) {
                 if ((isa == simd::Isa::Avx2 || isa == simd::Isa::Avx512) &&
-                    feature::lanes_shade(c) && acc.leap_map()) {
+                    feature::lanes_shade(c) && acc.leap_map() && !brick) {
                     std::vector<Rgba> corr_z = corr0;
                     corr_z.push_back(Rgba{});  // the zero entry idle lanes composite
                     simd::ShadeGrid sg_lanes = sg;

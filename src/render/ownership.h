@@ -22,10 +22,36 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
+#include "lacuna/renderer.h"
 #include "render/ray_march_kernel.h"
 
 namespace lacuna {
+
+// The whole grid seen through a brick's voxels: the whole grid's clamp box and cells with the
+// brick's strides, and the voxel pointer moved so that a whole-grid offset k*sz + j*sy + i lands
+// on the brick's voxel (i, j, k) - offset. Owned samples only read voxels of the brick
+// (BrickOwnership's condition), and so do their gradients' central differences (the ghost layer,
+// src/dist/decomposition.h); the moved pointer itself may point outside the buffer, which is why
+// it is formed by integer arithmetic and only ever dereferenced at in-brick offsets.
+inline ptrdiff_t brick_shift(const BrickOwnership& own, Vec3i brick_dims) {
+    const ptrdiff_t sy = brick_dims.x, sz = ptrdiff_t(brick_dims.x) * brick_dims.y;
+    return ptrdiff_t(own.offset.z) * sz + ptrdiff_t(own.offset.y) * sy + own.offset.x;
+}
+template <class T>
+const T* shift_to_whole(const T* p, ptrdiff_t shift) {
+    return reinterpret_cast<const T*>(reinterpret_cast<uintptr_t>(p) -
+                                      uintptr_t(shift) * sizeof(T));
+}
+template <class T>
+kernel::Grid<T, int64_t> brick_grid(const T* data, Vec3i brick_dims, const BrickOwnership& own) {
+    kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, own.whole_dims);
+    g.sy = ptrdiff_t(brick_dims.x);
+    g.sz = ptrdiff_t(brick_dims.x) * ptrdiff_t(brick_dims.y);
+    g.data = shift_to_whole(data, brick_shift(own, brick_dims));
+    return g;
+}
 
 // Coordinate `a` of lattice sample k: the kernel's expression, operation for operation.
 inline float lattice_coordinate(const kernel::IndexRay& r, int a, float t_base, float dt, int k) {

@@ -229,18 +229,8 @@ void render_tile_brick(const S& accel, const Volume& vol, const T* data, const B
                        const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
                        ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
                        std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
-    // 1. The whole grid's clamp box and cells with the brick's strides, and the voxel pointer
-    // moved so that a whole-grid offset k*sz + j*sy + i lands on the brick's voxel
-    // (i, j, k) - offset. Owned samples only read voxels of the brick (BrickOwnership's
-    // condition); the moved pointer itself may point outside the buffer, which is why it is
-    // formed by integer arithmetic and only ever dereferenced at in-brick offsets.
-    kernel::Grid<T, int64_t> g = kernel::make_grid<int64_t>(data, own.whole_dims);
-    g.sy = ptrdiff_t(vol.dims().x);
-    g.sz = ptrdiff_t(vol.dims().x) * ptrdiff_t(vol.dims().y);
-    const ptrdiff_t shift =
-        ptrdiff_t(own.offset.z) * g.sz + ptrdiff_t(own.offset.y) * g.sy + own.offset.x;
-    g.data = reinterpret_cast<const T*>(reinterpret_cast<uintptr_t>(data) -
-                                        uintptr_t(shift) * sizeof(T));
+    // 1. The whole grid through the brick's voxels (render/ownership.h brick_grid).
+    const kernel::Grid<T, int64_t> g = brick_grid(data, vol.dims(), own);
     const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, opt.step);
     const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
@@ -330,8 +320,16 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
         throw FrameError("sampling.interpolation",
                          "the structure was built for nearest sampling; expected nearest");
     if (opt.brick) {
-        if (opt.features.any() || opt.ert < 1.f)
-            throw FrameError("features", "a brick renders without features or early termination");
+        // A brick's samples composite with the other bricks' in front of and behind them: no
+        // early termination (the opacity in front is the other ranks'), and only features that
+        // act on each sample alone (not shadows, which reach into other bricks, nor a second TF
+        // or another blend mode, which composite differently).
+        const FeatureOptions& f = opt.features;
+        if (opt.ert < 1.f || f.shadows.enabled || f.blend != BlendMode::Composite ||
+            !m_back_lut.entries.empty())
+            throw FrameError("features",
+                             "a brick renders without early termination, shadows, blend modes or "
+                             "two TFs");
         check_brick(m_volume, *opt.brick);
     }
     check_rgb_options(m_volume, opt);

@@ -317,10 +317,12 @@ FrameResult Session::prepare(const FrameSpec& spec) {
     if (m_brick) {
         if (spec.renderer != Renderer::RayMarcher)
             throw FrameError("renderer", "distributed rendering takes the ray marcher only");
-        if (spec.features.any() || spec.two_tfs)
+        // Features that act on each sample alone (shading, gradient opacity, clip planes, crop,
+        // jitter); not shadows (they reach into other bricks) or what composites differently.
+        const FeatureOptions& f = spec.features;
+        if (f.shadows.enabled || f.blend != BlendMode::Composite || spec.two_tfs)
             throw FrameError("features",
-                             "distributed rendering takes no features yet "
-                             "(shading, clipping, crop, blend, jitter, two TFs)");
+                             "distributed rendering takes no shadows, blend modes or two TFs yet");
     }
     if (rgb_colours(*m_volume) && spec.renderer != Renderer::RayMarcher)  // src/render/rgb_march.h
         throw FrameError("renderer", "an RGB volume renders with the ray marcher only");

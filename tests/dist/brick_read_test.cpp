@@ -220,7 +220,7 @@ TEST(BrickRead, VisibleTreeFromSlabsIsTheWholeVolumesTree) {
             std::vector<SlabCounts> counts;
             for (int r = 0; r < n; ++r) {
                 Volume s = crop_brick(whole, ownership(slabs, r).offset, brick_voxels(slabs, r));
-                counts.emplace_back(s, slabs.bricks[size_t(r)], lut, 1);
+                counts.emplace_back(s, ownership(slabs, r).offset, slabs.bricks[size_t(r)], lut, 1);
             }
             // decompose_visible_slabs' weight with the ranks' allreduce done here: every slab's
             // count of the box, summed (tests/dist/mpi/ runs it over MPI).

@@ -6,6 +6,7 @@
 
 #include <cstring>
 
+#include "conformance/conformance_util.h"
 #include "dist/brick_io.h"
 #include "dist/composite.h"
 #include "dist/decomposition.h"
@@ -144,6 +145,101 @@ TEST(DistributedFrame, BricksTakeEverySampleOnceAndMatchOneProcess) {
     }
 }
 
+// Features that act on each sample alone (shading with either gradient source and every light,
+// gradient opacity, clip planes, a crop box, jitter, nearest samples) through bricks on every
+// kernel path this machine runs: the bricks' gradients at every voxel they interpolate are the
+// whole volume's (the ghost layer, dist/decomposition.h), so each sample is the one-process
+// sample and only compositing's association differs.
+TEST(DistributedFrame, PerSampleFeaturesThroughBricksMatchOneProcess) {
+    SyntheticOptions o;
+    o.dims = {33, 28, 37};
+    o.threads = 1;
+    const Volume whole = generate(SyntheticKind::SphereShells, o);
+    const TransferFunction tf = test_tf();
+    struct Feature {
+        const char* name;
+        void (*set)(FrameSpec&);
+    };
+    const Feature features[] = {
+        {"phong", [](FrameSpec& f) { f.features.shading = ShadingModel::Phong; }},
+        {"phong precomputed",
+         [](FrameSpec& f) {
+             f.features.shading = ShadingModel::Phong;
+             f.features.gradient = GradientSource::Precomputed;
+         }},
+        {"pbr spot",
+         [](FrameSpec& f) {
+             f.features.shading = ShadingModel::Pbr;
+             f.features.light.kind = LightKind::Spot;
+             f.features.light.position = {-20.f, 60.f, 50.f};
+             f.features.light.target = {16.f, 14.f, 18.f};
+             f.features.light.cone_deg = 40.f;
+         }},
+        {"gradient opacity",
+         [](FrameSpec& f) {
+             f.features.shading = ShadingModel::Phong;
+             f.features.gradient_opacity.enabled = true;
+             f.features.gradient_opacity.lo = 2.f;
+             f.features.gradient_opacity.hi = 30.f;
+         }},
+        {"clip and crop",
+         [](FrameSpec& f) {
+             f.features.clip_planes.push_back(ClipPlane{{0.6f, -0.8f, 0.f}, -4.f});
+             f.features.crop = true;
+             f.features.crop_box = {{2.f, 3.f, 4.f}, {29.f, 22.f, 31.f}};
+         }},
+        {"jitter shaded",
+         [](FrameSpec& f) {
+             f.features.jitter = true;
+             f.features.jitter_seed = 7;
+             f.features.shading = ShadingModel::Phong;
+         }},
+        {"nearest shaded",
+         [](FrameSpec& f) {
+             f.sampling.interpolation = Interpolation::Nearest;
+             f.features.shading = ShadingModel::Phong;
+         }},
+    };
+    const test::KernelPaths kp;
+    int view = 0;
+    for (const Feature& feat : features) {
+        for (simd::Isa isa : kp.paths) {
+            simd::set_isa(isa);
+            FrameSpec spec;
+            feat.set(spec);
+            const bool nearest = spec.sampling.interpolation == Interpolation::Nearest;
+            spec.structure = view % 3 == 0   ? Structure{structure::None{}}
+                             : view % 3 == 1 ? Structure{structure::Grid{}}
+                                             : Structure{structure::Bitfield{}};
+            if (nearest) spec.structure = structure::None{};
+            spec.width = spec.height = 40;
+            spec.sampling.early_termination = std::nullopt;
+            spec.camera.orbit.azimuth_deg = 41.f * float(view);
+            spec.camera.orbit.elevation_deg = -40.f + 19.f * float(view % 5);
+            ++view;
+            Session single(Volume(whole), 1);
+            single.set_transfer_function(tf);
+            spec.count_samples = true;
+            const FrameResult ref = single.render(spec);
+            size_t lit = 0;
+            for (size_t p = 0; p < ref.image.rgba.size(); p += 4)
+                lit += ref.image.rgba[p] + ref.image.rgba[p + 1] + ref.image.rgba[p + 2] > 0;
+            EXPECT_GT(lit, ref.image.rgba.size() / 4 / 10) << feat.name << ": a frame to compare";
+            for (int n : {2, 3, 7}) {
+                const Bricked b =
+                    render_bricked(whole, tf, spec, n, n % 2 ? Balance::Voxels : Balance::Visible);
+                const std::string what = std::string(feat.name) + " " + simd::to_string(isa) +
+                                         " ranks " + std::to_string(n);
+                expect_close(b.image, ref.image, what);
+                if (std::holds_alternative<structure::None>(spec.structure) &&
+                    spec.features.clip_planes.empty() && !spec.features.crop) {
+                    EXPECT_EQ(b.counts, ref.sample_counts) << what << ": every sample once";
+                }
+            }
+        }
+    }
+}
+
 TEST(DistributedFrame, BrickSessionsRefuseWhatTheyCannotRender) {
     SyntheticOptions o;
     o.dims = {16, 16, 16};
@@ -155,9 +251,12 @@ TEST(DistributedFrame, BrickSessionsRefuseWhatTheyCannotRender) {
     s.set_transfer_function(test_tf());
     FrameSpec f;
     f.width = f.height = 8;
-    f.features.shading = ShadingModel::Phong;
+    f.features.shadows.enabled = true;  // shadow rays reach into other bricks
     EXPECT_THROW(s.render(f), FrameError);
-    f.features.shading = ShadingModel::None;
+    f.features.shadows.enabled = false;
+    f.features.blend = BlendMode::Mip;  // composites by maximum, not front to back
+    EXPECT_THROW(s.render(f), FrameError);
+    f.features.blend = BlendMode::Composite;
     f.renderer = Renderer::Slicer;
     f.structure = structure::None{};
     EXPECT_THROW(s.render(f), FrameError);

@@ -109,6 +109,43 @@ TEST(MpiRender, VisibleBalanceOrthographicAndInside) {
         "inside", {2, 7}, {"binary-swap"});
 }
 
+// Features of one sample at a time under mpirun: Phong shading (the ghost layer gives every
+// brick the whole volume's gradients), a clip plane and jitter.
+TEST(MpiRender, ShadedClippedJitteredFramesMatchOneProcess) {
+    check_frames(shells_volume().string(),
+                 std::string(kFrame) + " --accel bitfield --shading phong --clip 0.6,-0.8,0,-4",
+                 "shaded", {2, 3, 7}, {"binary-swap"});
+    check_frames(shells_volume().string(),
+                 std::string(kFrame) + " --shading phong --gradient-volume --jitter", "jittered",
+                 {4}, {"direct", "radix-k"});
+}
+
+// --orbit and --repeat under mpirun: the bricks and structures made once, every frame the
+// one-process frame of its azimuth; --repeat reports the median of the warm frames.
+TEST(MpiRender, OrbitAndRepeatMatchOneProcess) {
+    const std::string vol = shells_volume().string();
+    const std::string frame = std::string(kFrame) + " --accel grid --orbit 3";
+    const CliResult r = run_cli("render " + vol + " " + frame + " --ert 1 --quiet --out " +
+                                    (dir() / "orbit_ref.png").string(),
+                                dir());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const CliResult m =
+        run_mpi(3, "render " + vol + " " + frame + " --composite binary-swap --out " +
+                       (dir() / "orbit.png").string());
+    ASSERT_EQ(m.code, 0) << m.err << m.out;
+    EXPECT_NE(m.out.find("orbit of 3 frames"), std::string::npos) << m.out;
+    for (const char* i : {"0000", "0001", "0002"})
+        expect_close(dir() / ("orbit_" + std::string(i) + ".png"),
+                     dir() / ("orbit_ref_" + std::string(i) + ".png"), std::string("orbit ") + i);
+    check_frames(vol, std::string(kFrame) + " --accel bitfield --repeat 3", "repeat", {2},
+                 {"direct"});
+    const CliResult rep = run_mpi(2, "render " + vol + " " + kFrame + " --repeat 3 --out " +
+                                         (dir() / "repeat_report.png").string());
+    ASSERT_EQ(rep.code, 0) << rep.err;
+    EXPECT_NE(rep.out.find("3 frames; the median of the 2 after the first"), std::string::npos)
+        << rep.out;
+}
+
 TEST(MpiRender, Ch2HeadMatchesOneProcess) {
     const std::string ch2 = "/usr/share/mricron/templates/ch2.nii.gz";
     if (!fs::exists(ch2)) GTEST_SKIP() << ch2 << " missing (mricron-data)";
@@ -275,7 +312,8 @@ TEST(MpiRender, HeatmapOfNoneIsTheOneProcessHeatmap) {
 }
 
 TEST(MpiRender, RefusedFramesAreOneLineFromRankZero) {
-    for (const char* flags : {"--shading phong", "--orbit 3", "--renderer slice"}) {
+    for (const char* flags : {"--shading phong --shadows", "--blend mip",
+                              "--tf-animate mr-default mr-skin", "--renderer slice"}) {
         const CliResult m = run_mpi(2, "render " + shells_volume().string() + " " + kFrame + " " +
                                            flags + " --out " + (dir() / "refused.png").string());
         EXPECT_NE(m.code, 0) << flags;

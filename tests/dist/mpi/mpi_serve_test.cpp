@@ -2,8 +2,9 @@
 // rendered by every rank, against the one-process `lacuna render --session` of the session the
 // same server saves for the same view (with early termination off, as distributed frames are):
 // within 1 of 255 on every channel and byte-identical on >= 99% of the pixels, across a TF
-// edit and a change of structure; a frame the ranks cannot take (shading) is the page's error
-// message and the next frame still comes; the job ends on SIGTERM without hanging.
+// edit, changes of structure and the shading and clip toggles; a frame the ranks cannot take
+// (the slicer) is the page's error message and the next frame still comes; the job ends on
+// SIGTERM without hanging.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -185,15 +186,20 @@ TEST(MpiServe, FramesOfEveryRankMatchOneProcessAcrossTfAndStructureChanges) {
             EXPECT_TRUE(binary);
             EXPECT_EQ(f.header["type"], "frame") << f.header.dump();
             EXPECT_EQ(f.header["id"], 50);
-            // Shading: the ranks take no features yet; an error naming them, and the next
-            // frame still comes.
-            json shaded = view("screenshot", 60, "bitfield", mr);
+            // The page's shading and clip toggles: per-sample features the ranks take.
+            json shaded = view("screenshot", 1, "bitfield", edited);
             shaded["shading"] = true;
-            c.send(shaded.dump());
+            shaded["clip"] = true;
+            check_view(c, shaded, 60, "shaded-clipped");
+            // The slicer: the ranks take the ray marcher only; an error naming the renderer, and
+            // the next frame still comes.
+            json sliced = view("screenshot", 70, "none", mr);
+            sliced["renderer"] = "slice";
+            c.send(sliced.dump());
             const json e = c.read_text();
             EXPECT_EQ(e["type"], "error") << e.dump();
-            EXPECT_NE(e.dump().find("features"), std::string::npos) << e.dump();
-            check_view(c, view("screenshot", 1, "minmax", mr), 70, "after-error");
+            EXPECT_NE(e.dump().find("renderer"), std::string::npos) << e.dump();
+            check_view(c, view("screenshot", 1, "minmax", mr), 80, "after-error");
         }
         EXPECT_TRUE(job.stop()) << "mpirun did not end on SIGTERM\n" << job.log();
     }
