@@ -42,8 +42,15 @@ void follow(const ServeArgs& a) {
     const std::optional<TransferFunction> tf = dist::await_start(comm);
     if (!tf) return;  // rank 0 could not start; it says why
     int64_t frames = 1;
-    dist::DistributedSession session(comm, volume_source(first_volume(a.volume, frames)), *tf,
-                                     dist_options(a.mpi), a.threads);
+    dist::VolumeSource source;
+    try {
+        source = volume_source(first_volume(a.volume, frames));
+    } catch (const std::exception& e) {
+        // This rank alone (rank 0 read the file): rank 0 waits in the session's first message.
+        std::fprintf(stderr, "lacuna: rank %d: %s\n", comm.rank(), e.what());
+        comm.abort(2);
+    }
+    dist::DistributedSession session(comm, source, *tf, dist_options(a.mpi), a.threads);
     dist::follow_rank0(session);
 }
 
