@@ -10,6 +10,7 @@
 #include "dist/brick_io.h"
 #include "dist/composite.h"
 #include "dist/decomposition.h"
+#include "lacuna/accel.h"
 #include "lacuna/orientation.h"
 #include "lacuna/session.h"
 #include "lacuna/synthetic.h"
@@ -106,9 +107,14 @@ TEST(DistributedFrame, BricksTakeEverySampleOnceAndMatchOneProcess) {
     o.threads = 1;
     const Volume whole = generate(SyntheticKind::SphereShells, o);
     const TransferFunction tf = test_tf();
-    const Case cases[] = {{"none", structure::None{}},         {"grid", structure::Grid{}},
-                          {"bitfield", structure::Bitfield{}}, {"kdtree", structure::KdTree{}},
-                          {"minmax", structure::MinMax{}},     {"distance", structure::Distance{}}};
+    // Every ray-marcher structure of the registry (accel_names()).
+    const Case cases[] = {
+        {"none", structure::None{}},          {"grid", structure::Grid{}},
+        {"bitfield", structure::Bitfield{}},  {"kdtree", structure::KdTree{}},
+        {"minmax", structure::MinMax{}},      {"minmax-interval", structure::MinMaxInterval{}},
+        {"boolean", structure::Boolean{}},    {"distance", structure::Distance{}},
+        {"chebyshev", structure::Chebyshev{}}};
+    EXPECT_EQ(std::size(cases), accel_names().size()) << "a structure is missing here";
     Session single(Volume(whole), 1);
     single.set_transfer_function(tf);
     int view = 0;

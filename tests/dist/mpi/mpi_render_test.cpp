@@ -100,6 +100,14 @@ TEST(MpiRender, GridBitfieldKdtreeMatchOneProcess) {
                      {2, 3, 4, 7}, {accel[0] == 'b' ? "binary-swap" : "direct"});
 }
 
+// The registry's other structures under mpirun (every structure: the in-process
+// DistributedFrame tests take each on 1, 2, 3, 4 and 7 bricks).
+TEST(MpiRender, EveryOtherStructureMatchesOneProcess) {
+    for (const char* accel : {"minmax", "minmax-interval", "boolean", "distance", "chebyshev"})
+        check_frames(shells_volume().string(), std::string(kFrame) + " --accel " + accel,
+                     std::string("every_") + accel, {3}, {"radix-k"});
+}
+
 TEST(MpiRender, VisibleBalanceOrthographicAndInside) {
     check_frames(shells_volume().string(), std::string(kFrame) + " --ortho --balance visible",
                  "ortho", {3, 4}, {"binary-swap", "radix-k"});
