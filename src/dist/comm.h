@@ -33,6 +33,17 @@ class Comm {
     void recv(int from, int tag, void* data, size_t bytes);
     // Exchanges with `peer` at once (no deadlock whichever side is first).
     void sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* in, size_t in_bytes);
+    // Exchanges with several peers at once: transfer i sends `out` to `peer` and receives `in`
+    // (its size known) from it. Every transfer is posted before any is waited for, so no order
+    // of the peers can deadlock and no pair waits for another pair's turn (radix-k's rounds).
+    struct Transfer {
+        int peer;
+        const void* out;
+        size_t out_bytes;
+        void* in;
+        size_t in_bytes;
+    };
+    void exchange(int tag, const std::vector<Transfer>& transfers);
     // Every rank's `mine` (the same size everywhere) on rank 0, in rank order.
     std::vector<uint8_t> gather(const void* mine, size_t bytes);
     // The element-wise sum of every rank's `v` (the same length everywhere) into rank 0's `v`

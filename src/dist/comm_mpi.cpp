@@ -103,6 +103,20 @@ void Comm::sendrecv(int peer, int tag, const void* out, size_t out_bytes, void* 
     } while (out_bytes > 0 || in_bytes > 0);
 }
 
+void Comm::exchange(int tag, const std::vector<Transfer>& transfers) {
+    std::vector<MPI_Request> req;
+    req.reserve(2 * transfers.size());
+    for (const Transfer& t : transfers) {
+        if (t.out_bytes > size_t(INT_MAX) || t.in_bytes > size_t(INT_MAX))
+            throw Error("mpi", "exchange", "expected under 2 GiB per message");
+        req.emplace_back();
+        MPI_Irecv(t.in, int(t.in_bytes), MPI_BYTE, t.peer, tag, MPI_COMM_WORLD, &req.back());
+        req.emplace_back();
+        MPI_Isend(t.out, int(t.out_bytes), MPI_BYTE, t.peer, tag, MPI_COMM_WORLD, &req.back());
+    }
+    MPI_Waitall(int(req.size()), req.data(), MPI_STATUSES_IGNORE);
+}
+
 std::vector<uint8_t> Comm::gather(const void* mine, size_t bytes) {
     if (bytes > size_t(INT_MAX)) throw Error("mpi", "gather", "expected under 2 GiB per rank");
     std::vector<uint8_t> all(m_rank == 0 ? bytes * size_t(m_size) : 0);

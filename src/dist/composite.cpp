@@ -233,30 +233,37 @@ Partial composite_radix_k(Comm& comm, Partial mine, const Decomposition& d, Vec3
         auto part = [&](int q) {
             return Rect{0, r0 + (r1 - r0) * q / g, mine.width, r0 + (r1 - r0) * (q + 1) / g};
         };
-        // The g pieces of my part, by digit: mine, and the others' by exchange (step j pairs
-        // digit x with x XOR j, a perfect matching: no cycle of waiting ranks).
-        std::vector<Rect> rects(static_cast<size_t>(g));
-        std::vector<std::vector<float>> pieces(static_cast<size_t>(g));
+        // The g pieces of my part, by digit: mine, and the others' by one exchange with all
+        // g - 1 peers at once (Comm::exchange): first the rectangles, then their pixels.
+        const size_t gs = size_t(g);
+        std::vector<Rect> rects(gs), out_r(gs);
+        std::vector<std::vector<float>> pieces(gs), out_px(gs);
         const Rect keep = part(me);
         rects[size_t(me)] = keep.empty() ? Rect{} : nonempty_rect(mine, keep);
         pieces[size_t(me)] = pack(mine, rects[size_t(me)]);
-        for (int j = 1; j < g; ++j) {
-            const int other = me ^ j;
-            const int peer = a + other * unit + rank % unit;
+        auto peer_of = [&](int other) { return a + other * unit + rank % unit; };
+        std::vector<Comm::Transfer> t;
+        for (int other = 0; other < g; ++other) {
+            if (other == me) continue;
             const Rect give = part(other);
-            const Rect out_r = give.empty() ? Rect{} : nonempty_rect(mine, give);
-            Rect in_r;
-            comm.sendrecv(peer, kTagSwap, &out_r, sizeof out_r, &in_r, sizeof in_r);
-            const std::vector<float> out_px = pack(mine, out_r);
-            std::vector<float>& in_px = pieces[size_t(other)];
-            in_px.assign(size_t(in_r.pixels()) * 4, 0.f);
-            comm.sendrecv(peer, kTagSwap + 1, out_px.data(), out_px.size() * sizeof(float),
-                          in_px.data(), in_px.size() * sizeof(float));
-            st.bytes_sent += sizeof out_r + out_px.size() * sizeof(float);
-            st.messages_received += 2,
-                st.bytes_received += sizeof in_r + in_px.size() * sizeof(float);
-            rects[size_t(other)] = in_r;
+            out_r[size_t(other)] = give.empty() ? Rect{} : nonempty_rect(mine, give);
+            t.push_back({peer_of(other), &out_r[size_t(other)], sizeof(Rect), &rects[size_t(other)],
+                         sizeof(Rect)});
         }
+        comm.exchange(kTagSwap, t);
+        t.clear();
+        for (int other = 0; other < g; ++other) {
+            if (other == me) continue;
+            const size_t o = size_t(other);
+            out_px[o] = pack(mine, out_r[o]);
+            pieces[o].assign(size_t(rects[o].pixels()) * 4, 0.f);
+            t.push_back({peer_of(other), out_px[o].data(), out_px[o].size() * sizeof(float),
+                         pieces[o].data(), pieces[o].size() * sizeof(float)});
+            st.bytes_sent += sizeof(Rect) + out_px[o].size() * sizeof(float);
+            st.messages_received += 2,
+                st.bytes_received += sizeof(Rect) + pieces[o].size() * sizeof(float);
+        }
+        comm.exchange(kTagSwap + 1, t);
         // Front to back over zero in the block's visibility order, then back into `mine`.
         for (int y = keep.y0; y < keep.y1; ++y)
             std::fill_n(acc.at(0, y), size_t(mine.width) * 4, 0.f);

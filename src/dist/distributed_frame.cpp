@@ -1,5 +1,6 @@
 #include "dist/distributed_frame.h"
 
+#include <malloc.h>
 #include <sched.h>
 #include <sys/resource.h>
 
@@ -63,6 +64,13 @@ DistributedSession::DistributedSession(Comm& comm, const VolumeSource& source,
                                        const TransferFunction& tf, const DistOptions& options,
                                        int threads)
     : m_comm(comm), m_options(options), m_threads(rank_threads(threads)) {
+    // Freed buffers stay in the heap: every frame allocates and frees image-sized buffers (the
+    // partials, compositing's pieces and strips), and on a VM each first touch of a page the
+    // kernel hands out again costs tens of microseconds (docs/distributed.md, "Compositing cost
+    // model"), which would swamp a warm frame's compositing. Process-wide, as `lacuna bench mpi
+    // --worker` does; only distributed front ends construct this.
+    mallopt(M_MMAP_THRESHOLD, 1 << 30);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
     threads = m_threads;
     DistFrame out;  // its decomposition and whole_voxels, kept as the members below
     RankReport& me = m_loaded;
