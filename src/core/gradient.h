@@ -55,4 +55,22 @@ inline void central_gradient(const T* data, ptrdiff_t sy, ptrdiff_t sz, const fl
     }
 }
 
+// The same gradient at voxel (i, j, k) itself (nearest sampling: the sample moved to its voxel),
+// from the voxel's own central differences only. central_gradient at that integer point gives
+// these bits for integer voxels (weights 0 or 1 on exact differences), but it also reads the
+// cell's far corners, one voxel further than the differences need: a voxel past a distributed
+// brick's ghost layer (src/dist/decomposition.h). This reads the six neighbours only, clamped
+// to the grid as above (last = dims - 1).
+template <class T>
+inline void voxel_gradient(const T* data, ptrdiff_t sy, ptrdiff_t sz, const int last[3],
+                           const float inv_sp[3], int i, int j, int k, float g[3]) {
+    auto v = [&](int a, int b, int c) {
+        a = std::clamp(a, 0, last[0]), b = std::clamp(b, 0, last[1]), c = std::clamp(c, 0, last[2]);
+        return float(data[ptrdiff_t(c) * sz + ptrdiff_t(b) * sy + a]);
+    };
+    g[0] = (v(i + 1, j, k) - v(i - 1, j, k)) * 0.5f * inv_sp[0];
+    g[1] = (v(i, j + 1, k) - v(i, j - 1, k)) * 0.5f * inv_sp[1];
+    g[2] = (v(i, j, k + 1) - v(i, j, k - 1)) * 0.5f * inv_sp[2];
+}
+
 }  // namespace lacuna

@@ -262,14 +262,23 @@ LACUNA_AVX2 void gradients8(const ShadeGrid& g, const T* data, const float* px, 
             inside =
                 _mm256_and_si256(inside, _mm256_cmpgt_epi32(_mm256_set1_epi32(g.cell[a]), c[a]));
         }
-        // Lanes on a face: central_gradient at the end; their rows are read at cell (1, 1, 1).
-        // Lanes n.. are padding: whatever they hold, never the scalar path.
-        const int faces = ~_mm256_movemask_ps(_mm256_castsi256_ps(inside)) & 0xff & ((1 << n) - 1);
-        if (faces == (1 << n) - 1) {
+        // Lanes n.. are padding: whatever they hold, never the scalar path, and never read.
+        inside = _mm256_and_si256(
+            inside,
+            _mm256_cmpgt_epi32(_mm256_set1_epi32(n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+        // Lanes on a face: central_gradient at the end. Their rows are read at the first inside
+        // lane's cell, whose rows are voxels the data holds: `data` may be a brick's voxels seen
+        // as the whole grid (render/ownership.h brick_grid), where only the owned samples' rows
+        // are in memory, so no fixed cell such as (1, 1, 1) is safe.
+        const int in = _mm256_movemask_ps(_mm256_castsi256_ps(inside));
+        const int faces = ~in & 0xff & ((1 << n) - 1);
+        if (in == 0) {
             central_gradients(g, data, px, py, pz, gx, gy, gz, n);
             return;
         }
-        for (int a = 0; a < 3; ++a) c[a] = _mm256_blendv_epi8(_mm256_set1_epi32(1), c[a], inside);
+        const __m256i first = _mm256_set1_epi32(__builtin_ctz(unsigned(in)));
+        for (int a = 0; a < 3; ++a)
+            c[a] = _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(c[a], first), c[a], inside);
         alignas(32) int32_t o[8];
         _mm256_store_si256(
             reinterpret_cast<__m256i*>(o),

@@ -131,10 +131,18 @@ inline float value(const Context& c, const kernel::Grid<T, Index>& g, float x, f
 template <class T, class Index>
 inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x, float y,
                       float z) {
+    const float isp[3] = {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z};
     if (c.nearest) {
-        x = float(int(std::clamp(x, 0.f, g.hi_x) + 0.5f));
-        y = float(int(std::clamp(y, 0.f, g.hi_y) + 0.5f));
-        z = float(int(std::clamp(z, 0.f, g.hi_z) + 0.5f));
+        const int i = int(std::clamp(x, 0.f, g.hi_x) + 0.5f),
+                  j = int(std::clamp(y, 0.f, g.hi_y) + 0.5f),
+                  k = int(std::clamp(z, 0.f, g.hi_z) + 0.5f);
+        if (!c.grad[0]) {
+            const int last[3] = {g.cell_x + 1, g.cell_y + 1, g.cell_z + 1};
+            float gr[3];
+            voxel_gradient(g.data, g.sy, g.sz, last, isp, i, j, k, gr);
+            return {gr[0], gr[1], gr[2]};
+        }
+        x = float(i), y = float(j), z = float(k);
     }
     if (c.grad[0]) {
         // The gradient volume is laid out as the voxels are (with a brick's strides and moved
@@ -148,7 +156,7 @@ inline Vec3f gradient(const Context& c, const kernel::Grid<T, Index>& g, float x
                 kernel::trilinear(of(c.grad[2]), x, y, z)};
     }
     // The voxels' central differences, interpolated at the sample (core/gradient.h).
-    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z}, isp[3] = {c.inv_sp.x, c.inv_sp.y, c.inv_sp.z};
+    const float hi[3] = {g.hi_x, g.hi_y, g.hi_z};
     const int cell[3] = {g.cell_x, g.cell_y, g.cell_z};
     float gr[3];
     central_gradient(g.data, g.sy, g.sz, hi, cell, isp, x, y, z, gr);

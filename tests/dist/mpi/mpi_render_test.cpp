@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include "apps/cli_run.h"
+#include "dist/mpi/mpirun.h"
 #include "lacuna/image.h"
 
 namespace lacuna::test {
@@ -25,12 +26,11 @@ const fs::path& dir() {
     return d;
 }
 
-// mpirun with what this machine needs: more ranks than cores, root in containers.
+// mpirun (mpirun.h) with N ranks of the CLI.
 CliResult run_mpi(int ranks, const std::string& args) {
-    const std::string root = ::geteuid() == 0 ? " --allow-run-as-root" : "";
-    return run_command(std::string(LACUNA_MPIEXEC) + root + " --oversubscribe -np " +
-                           std::to_string(ranks) + " " + LACUNA_CLI_PATH + " " + args,
-                       dir());
+    return run_command(
+        mpirun_command() + " -np " + std::to_string(ranks) + " " + LACUNA_CLI_PATH + " " + args,
+        dir());
 }
 
 // Within 1 of 255 everywhere, identical on >= 99% of the pixels; returns the differing pixels.
@@ -360,8 +360,7 @@ TEST(MpiRender, LoadFailuresAreOneLineFromRankZero) {
 TEST(MpiRender, BenchMpiRunsAndItsCountsAreTheModels) {
     const fs::path out = dir() / "bench";
     const CliResult r = run_cli(
-        "bench mpi --quick --mpirun " + std::string(LACUNA_MPIEXEC) + " --out-dir " + out.string(),
-        dir());
+        "bench mpi --quick --mpirun '" + mpirun_launcher() + "' --out-dir " + out.string(), dir());
     ASSERT_EQ(r.code, 0) << r.err << r.out;
     const std::string md = slurp_file(out / "mpi.md");
     for (const char* want :

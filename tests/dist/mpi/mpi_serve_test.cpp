@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "apps/cli_run.h"
+#include "dist/mpi/mpirun.h"
 #include "lacuna/image.h"
 #include "lacuna/transfer_function.h"
 #include "serve/server_test_util.h"
@@ -51,11 +52,10 @@ void write_file(const fs::path& p, const std::string& bytes) {
 class Job {
   public:
     Job(int ranks, const std::string& args) {
-        const std::string root = ::geteuid() == 0 ? " --allow-run-as-root" : "";
         const std::string cmd = "sh -c 'echo $$ > " + (dir() / "job.pid").string() + "; exec " +
-                                LACUNA_MPIEXEC + root + " --oversubscribe -np " +
-                                std::to_string(ranks) + " " + LACUNA_CLI_PATH + " " + args +
-                                "' > " + log_path().string() + " 2>&1 &";
+                                mpirun_command() + " -np " + std::to_string(ranks) + " " +
+                                LACUNA_CLI_PATH + " " + args + "' > " + log_path().string() +
+                                " 2>&1 &";
         fs::remove(dir() / "job.pid");
         EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
         // The URL line (port 0: the server's choice), within a minute.
@@ -213,14 +213,11 @@ TEST(MpiServe, StartFailuresAreOneLineFromRankZeroAndEndEveryRank) {
     const CliResult g = run_cli(
         "generate sphere-shells --dims 20x18x16 --out " + shells.string() + " --quiet", dir());
     ASSERT_EQ(g.code, 0) << g.err;
-    const std::string root = ::geteuid() == 0 ? " --allow-run-as-root" : "";
     for (const std::string& args :
          {"serve " + (dir() / "absent.nrrd").string() + " --port 0",
           "serve " + shells.string() + " --port 0 --labels " + shells.string()}) {
-        const CliResult m =
-            run_command("timeout 120 " + std::string(LACUNA_MPIEXEC) + root +
-                            " --oversubscribe -np 3 " + LACUNA_CLI_PATH + " " + args,
-                        dir());
+        const CliResult m = run_command(
+            "timeout 120 " + mpirun_command() + " -np 3 " + LACUNA_CLI_PATH + " " + args, dir());
         EXPECT_EQ(m.code, 2) << args << ": " << m.err;
         size_t lines = 0;
         for (size_t p = m.err.find("lacuna:"); p != std::string::npos;
