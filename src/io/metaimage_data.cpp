@@ -147,7 +147,16 @@ MetaHeaderOrientation check_metaimage_header(const std::string& path) {
                             (key.size() > kMaxField ? "key" : "value") + " of " +
                             std::to_string(std::max(key.size(), value.size())) +
                             " characters, MetaImage allows " + std::to_string(kMaxField));
-        if (eq == std::string::npos) continue;
+        // A line without a separator is no field, but MetaIO's key runs on across the newline
+        // to the next '=' ("NDims\nTransformMatrix = -1 ..." set NDims to -1 unseen, and MetaIO
+        // then read NDims^2 numbers: a hang, fuzz_metaimage, 2026-12-07). So every non-blank
+        // line is "Key = value" (or "Key: value"), and what MetaIO reads is what was checked.
+        if (eq == std::string::npos) {
+            if (key.empty()) continue;
+            throw Error(path, "header",
+                        "line " + std::to_string(n) + " '" + one_line(key, 40) +
+                            "' has no '=' (expected 'Key = value' lines up to ElementDataFile)");
+        }
         // The header ends where MetaIO's ends: at the key ElementDataFile, spelt exactly so
         // (MET_Read compares keys with strcmp). Stopping at any spelling let MetaIO parse on,
         // unchecked, past an "elementDataFile" line into the voxels, where a key longer than its

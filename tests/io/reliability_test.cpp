@@ -324,6 +324,29 @@ TEST(IoMetaImage, NDimsMetaIOWouldSeeIsCheckedWhateverItsSeparator) {
     EXPECT_EQ(read_volume(dir.file("ok.mha")).dims(), (Vec3i{2, 2, 2}));
 }
 
+// fuzz_metaimage (2026-12-07): a line without '=' was no field to the check, but MetaIO's key
+// runs on to the next separator, across the newline: "NDims\nTransformMatrix = -1 0 ..." gave
+// NDims -1 and MetaIO read NDims^2 numbers forever (the Release CLI hung; 101 bytes). Every
+// non-blank line before ElementDataFile now needs its separator; blank lines stay allowed.
+TEST(IoMetaImage, LinesWithoutASeparatorAreRefusedBeforeMetaIOJoinsThem) {
+    ScratchDir dir;
+    const std::string tail =
+        "TransformMatrix = -1 0 0 0 -1 0 0 0 1\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+        "ElementDataFile = LOCAL\n" +
+        std::string(8, '\0');
+    test::write_text(dir.file("joined.mha"), "ObjectType = Image\nNDims\n" + tail);
+    test::write_text(dir.file("word.mha"), "ObjectType = Image\nNDims = 3\n  stray  \n" + tail);
+    test::write_text(dir.file("blank.mha"), "ObjectType = Image\n\n  \t\nNDims = 3\n\n" + tail);
+    std::string msg = read_error(dir.file("joined.mha"));
+    EXPECT_NE(msg.find("joined.mha: header: line 2 'NDims' has no '=' (expected 'Key = value' "
+                       "lines up to ElementDataFile)"),
+              std::string::npos)
+        << msg;
+    msg = read_error(dir.file("word.mha"));
+    EXPECT_NE(msg.find("word.mha: header: line 3 'stray' has no '='"), std::string::npos) << msg;
+    EXPECT_EQ(read_volume(dir.file("blank.mha")).dims(), (Vec3i{2, 2, 2}));
+}
+
 // fuzz_metaimage (2026-12-02): the header check stopped at "elementDataFile" (any spelling),
 // MetaIO only at "ElementDataFile" (strcmp), so MetaIO parsed on, unchecked, into the next
 // lines, and a key longer than its char[255] aborted in strcpy (fortify). The check now ends the
