@@ -311,8 +311,42 @@ void BrickGrid::refine() {
         [&](size_t i) { return next_invisible[m_fine_lo[i]] > m_fine_hi[i]; }, near);
     m_leap.assign(8 * n + 1, 0);  // padding: kernels read 32-bit words
     octant_distances(m_nf, near.data(), m_opts.threads, m_leap.data());
+    find_surface();
     m_stats.refine_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The surface runs (surface_runs()): an occupied brick is on the surface unless all 26
+// neighbours are occupied; bricks past the grid count as unoccupied. Zero words are skipped whole.
+void BrickGrid::find_surface() {
+    m_surface.clear();
+    auto occ = [&](int x, int y, int z) {
+        return x >= 0 && y >= 0 && z >= 0 && x < m_nb[0] && y < m_nb[1] && z < m_nb[2] &&
+               occupied(x, y, z);
+    };
+    auto surface = [&](int x, int y, int z) {
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    if (!occ(x + dx, y + dy, z + dz)) return true;
+        return false;
+    };
+    for (int z = 0; z < m_nb[2]; ++z)
+        for (int y = 0; y < m_nb[1]; ++y) {
+            int run = -1;  // first brick of the open run
+            for (int x = 0; x <= m_nb[0]; ++x) {
+                if (x < m_nb[0] && (x & 3) == 0 && word(x, y, z) == 0 && run < 0) {
+                    x += 3;  // a block without an occupied brick
+                    continue;
+                }
+                const bool on = x < m_nb[0] && occupied(x, y, z) && surface(x, y, z);
+                if (on && run < 0) run = x;
+                if (!on && run >= 0) {
+                    m_surface.push_back({uint16_t(run), uint16_t(x - 1), uint16_t(y), uint16_t(z)});
+                    run = -1;
+                }
+            }
+        }
 }
 
 void BrickGrid::set_transfer_function(const TransferLut& lut) {

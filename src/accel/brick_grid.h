@@ -79,6 +79,19 @@ class BrickGrid final : public OctreeBase {
         return size_t(m_nf[0]) * size_t(m_nf[1]) * size_t(m_nf[2]);
     }
 
+    // Also made by refine(): the occupied bricks that have an unoccupied brick (or the grid's
+    // border) among their 26 neighbours, as runs along x: bricks x0..x1 of row (y, z). A ray
+    // from an eye outside the grid that comes within a brick of an occupied brick's box first
+    // comes that close to one of these (render/screen_cover.h has the argument), so their boxes
+    // alone bound the pixels whose rays can meet a visible sample. nullptr until refine() ran
+    // for the current TF.
+    struct BrickRun {
+        uint16_t x0, x1, y, z;
+    };
+    const std::vector<BrickRun>* surface_runs() const {
+        return m_mask_ready ? &m_surface : nullptr;
+    }
+
     int brick_log2() const { return m_log2; }
     const int* bricks() const { return m_nb; }
     // Bit of brick (x, y, z) in its block's word.
@@ -146,6 +159,8 @@ class BrickGrid final : public OctreeBase {
     std::vector<uint16_t> m_fine_lo, m_fine_hi;  // apron ranges of the fine bricks (leap map)
     int m_nf[3] = {0, 0, 0};
     std::vector<uint16_t> m_leap;
+    std::vector<BrickRun> m_surface;
+    void find_surface();
 };
 
 // Front-to-back walk of one ray through the grid; hands out the stretches that may hold visible

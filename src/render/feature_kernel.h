@@ -922,14 +922,15 @@ class ShadedLanesPolicy {
     uint32_t m_n[simd::kShadeRecords] = {};
 };
 
-// One tile of shaded rays in lanes, leaping through the refined `grid` (leap_map() set).
+// One tile of shaded rays in lanes, leaping through the refined `grid` (leap_map() set);
+// pixels outside `cover` are written empty (render/screen_cover.h).
 // `corr_z`: the step-corrected LUT with a zero entry appended.
 template <class T>
 void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Volume& vol,
                               const T* data, const simd::ShadeFrame& sf,
                               const std::vector<Rgba>& corr_z, const Camera& cam,
                               const RenderOptions& opt, int x0, int y0, int x1, int y1,
-                              RenderResult& out, Counts& counts) {
+                              RenderResult& out, Counts& counts, const ScreenCover* cover) {
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
     simd::LaneGrid lg = lane_grid(g, c.dt, c.map, corr_z.size(), c.ert);
     set_leap(lg, grid);
@@ -941,11 +942,13 @@ void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Vol
     if (simd::active_isa() == simd::Isa::Avx512) {
         schedule_tile_lanes<32>(
             kWholeRay, vol, cam, c.dt, 0.f, c.ert, x0, y0, x1, y1, policy, counts.samples,
-            counts.rays, [&](simd::Lanes& L, auto& refill) {
+            counts.rays,
+            [&](simd::Lanes& L, auto& refill) {
                 simd::march_shaded_lanes16<T, std::remove_reference_t<decltype(refill)>>(
                     L, lg, data, lut, sf, policy.queue(), policy.records(), policy.lane_records(),
                     refill);
-            });
+            },
+            cover);
         return;
     }
     schedule_tile_lanes<8>(
@@ -954,7 +957,8 @@ void render_tile_shaded_lanes(const Context& c, const BrickGrid& grid, const Vol
             simd::march_shaded_lanes8<T, std::remove_reference_t<decltype(refill)>, true>(
                 L, lg, data, lut, sf, policy.queue(), policy.records(), policy.lane_records(),
                 refill);
-        });
+        },
+        cover);
 }
 #endif
 

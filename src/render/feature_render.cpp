@@ -288,13 +288,16 @@ RenderResult RayMarcher::render_features(const Camera& cam, const RenderOptions&
                         f.light.intensity,
                         f.light.kind == LightKind::Head,
                         {c.light_dir.x, c.light_dir.y, c.light_dir.z}};
+                    // One TF, no clipping: the grid's occupancy bounds the pixels that can see
+                    // anything (render/screen_cover.h).
+                    const std::optional<ScreenCover> cover = ScreenCover::build(acc, m_volume, cam);
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
                                            feature::Counts n;
                                            if ((x1 - x0) * (y1 - y0) <= kMaxTilePixels)
                                                feature::render_tile_shaded_lanes(
                                                    c, acc, m_volume, data, sf, corr_z, cam, opt, x0,
-                                                   y0, x1, y1, out, n);
+                                                   y0, x1, y1, out, n, cover ? &*cover : nullptr);
                                            else
                                                feature::render_tile<feature::ShadeOps<8>>(
                                                    c, acc, g, sg, cam, opt, x0, y0, x1, y1, out, n);

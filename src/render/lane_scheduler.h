@@ -30,6 +30,7 @@
 #include "lacuna/renderer.h"
 #include "lacuna/volume.h"
 #include "render/pixel_driver.h"
+#include "render/screen_cover.h"
 
 namespace lacuna {
 
@@ -62,11 +63,13 @@ inline void set_leap(simd::LaneGrid& lg, const BrickGrid& grid) {
     lg.leap_octant = int32_t(grid.leap_octant_stride());
 }
 
-// Runs `march(lanes, refill)` over the tile's rays; dt, chunk and ert as the kernel's.
+// Runs `march(lanes, refill)` over the tile's rays; dt, chunk and ert as the kernel's. Pixels
+// outside `cover` (when given) are written empty without marching.
 template <int W, class S, class Policy, class March>
 void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, float dt,
                          float chunk, float ert, int x0, int y0, int x1, int y1, Policy& policy,
-                         uint64_t& tile_samples, uint64_t& tile_rays, March&& march) {
+                         uint64_t& tile_samples, uint64_t& tile_rays, March&& march,
+                         const ScreenCover* cover = nullptr) {
     using Cursor = typename S::Cursor;
     // Whole rays (NoAccel: one segment [t_near, t_far], the leaping kernels' case): the run is
     // LatticeRuns' first, computed here without a cursor, and there is never a second.
@@ -137,8 +140,10 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
             Vec3f dir;
             float t_near, t_far;
             int kb, ke;
-            if (ray_of(next_pixel++, r, dir, t_near, t_far)) {
-                ++tile_rays;
+            const bool hit = ray_of(next_pixel++, r, dir, t_near, t_far);
+            tile_rays += hit;
+            // Outside the screen cover the ray has no visible sample (render/screen_cover.h).
+            if (hit && (!cover || cover->covered(x, y))) {
                 Slot& sl = slot[l];
                 const float t_base = policy.t_base(x, y, t_near);
                 const int k_end = lattice_end(t_base, t_far, dt);

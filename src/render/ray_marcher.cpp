@@ -16,6 +16,7 @@
 #include "render/pixel_driver.h"
 #include "render/ray_march_kernel.h"
 #include "render/rgb_march.h"
+#include "render/screen_cover.h"
 #include "render/volume_frame.h"
 
 namespace lacuna {
@@ -98,7 +99,7 @@ template <class T, class Index, bool kNearest, class S>
 void render_tile(const S& accel, const Volume& vol, const T* data, const Camera& cam,
                  const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map, int x0,
                  int y0, int x1, int y1, RenderResult& out, std::atomic<uint64_t>& samples,
-                 std::atomic<uint64_t>& rays) {
+                 std::atomic<uint64_t>& rays, const ScreenCover* cover) {
     const kernel::Grid<T, Index> g = kernel::make_grid<Index>(data, vol.dims());
     const Vec3f inv_sp = inverse_spacing(vol);
     const float dt = sample_distance(vol, opt.step);
@@ -110,8 +111,9 @@ void render_tile(const S& accel, const Volume& vol, const T* data, const Camera&
             kernel::Accum acc;
             uint32_t n = 0;
             float t_near, t_far;
-            if (kernel::intersect_box(r, hi, t_near, t_far)) {
-                ++tile_rays;
+            const bool hit = kernel::intersect_box(r, hi, t_near, t_far);
+            tile_rays += hit;
+            if (hit && (!cover || cover->covered(x, y))) {  // render/screen_cover.h
                 typename S::Cursor cursor(accel, r, t_near, t_far, dt,
                                           opt.ert < 1.f ? kCursorChunk * dt : 0.f);
                 kernel::RayStream<T, Index, kNearest> stream(g, r, t_near, dt, lut.data(), map,
@@ -136,7 +138,7 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
                        const RenderOptions& opt, const std::vector<Rgba>& lut, ValueToLut map,
                        int x0, int y0, int x1, int y1, RenderResult& out,
                        std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays, March&& march,
-                       const BrickGrid* leap = nullptr) {
+                       const ScreenCover* cover, const BrickGrid* leap = nullptr) {
     const kernel::Grid<T, int32_t> g = kernel::make_grid<int32_t>(data, vol.dims());
     const float dt = sample_distance(vol, opt.step);
     simd::LaneGrid lg = lane_grid(g, dt, map, lut.size(), opt.ert);
@@ -146,7 +148,7 @@ void render_tile_lanes(const S& accel, const Volume& vol, const T* data, const C
     schedule_tile_lanes<W>(
         accel, vol, cam, dt, opt.ert < 1.f ? kLaneChunk * dt : 0.f, opt.ert, x0, y0, x1, y1, policy,
         tile_samples, tile_rays,
-        [&](simd::Lanes& L, auto& refill) { march(L, lg, data, &lut[0].r, refill); });
+        [&](simd::Lanes& L, auto& refill) { march(L, lg, data, &lut[0].r, refill); }, cover);
     samples += tile_samples;
     rays += tile_rays;
 }
@@ -157,7 +159,8 @@ template <class T, bool kNearest, class S>
 void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol, const T* data,
                     const Camera& cam, const RenderOptions& opt, const std::vector<Rgba>& lut,
                     ValueToLut map, int x0, int y0, int x1, int y1, RenderResult& out,
-                    std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays) {
+                    std::atomic<uint64_t>& samples, std::atomic<uint64_t>& rays,
+                    const ScreenCover* cover) {
     if (rgb_colours(vol)) {  // colour from the data: the one-ray kernel of render/rgb_march.h only
         render_rgb_tile<T, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
                                      samples, rays);
@@ -165,7 +168,7 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
     }
     if (!small || (x1 - x0) * (y1 - y0) > kMaxTilePixels) {
         render_tile<T, int64_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                          samples, rays);
+                                          samples, rays, cover);
         return;
     }
 #if LACUNA_SIMD_X86
@@ -181,7 +184,7 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                     simd::march_lanes16<false, T, std::remove_reference_t<decltype(refill)>, true,
                                         2>(L, lg, d, l, refill);
                 },
-                &accel);
+                cover, &accel);
             return;
         }
         if (isa == simd::Isa::Avx2 && accel.leap_map()) {
@@ -192,7 +195,7 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
                     simd::march_lanes8<false, T, std::remove_reference_t<decltype(refill)>, true>(
                         L, lg, d, l, refill);
                 },
-                &accel);
+                cover, &accel);
             return;
         }
     }
@@ -200,24 +203,26 @@ void render_tile_on(simd::Isa isa, bool small, const S& accel, const Volume& vol
     switch (isa) {
 #if LACUNA_SIMD_X86
         case simd::Isa::Avx512:
-            render_tile_lanes<16>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out,
-                                  samples, rays,
-                                  [](auto&&... a) { simd::march_lanes16<kNearest, T>(a...); });
+            render_tile_lanes<16>(
+                accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
+                [](auto&&... a) { simd::march_lanes16<kNearest, T>(a...); }, cover);
             return;
         case simd::Isa::Avx2:
-            render_tile_lanes<8>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples,
-                                 rays, [](auto&&... a) { simd::march_lanes8<kNearest, T>(a...); });
+            render_tile_lanes<8>(
+                accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
+                [](auto&&... a) { simd::march_lanes8<kNearest, T>(a...); }, cover);
             return;
 #if defined(__SSE4_1__)
         case simd::Isa::Sse41:
-            render_tile_lanes<4>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples,
-                                 rays, [](auto&&... a) { simd::march_lanes4<kNearest, T>(a...); });
+            render_tile_lanes<4>(
+                accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1, out, samples, rays,
+                [](auto&&... a) { simd::march_lanes4<kNearest, T>(a...); }, cover);
             return;
 #endif
 #endif
         default:
             render_tile<T, int32_t, kNearest>(accel, vol, data, cam, opt, lut, map, x0, y0, x1, y1,
-                                              out, samples, rays);
+                                              out, samples, rays, cover);
     }
 }
 
@@ -371,12 +376,18 @@ RenderResult RayMarcher::render(const Camera& world_cam, const RenderOptions& wo
             const bool small = m_volume.voxel_count() < (size_t(1) << 31);
             static const NoAccel kNone;
             visit_accel(m_accel ? *m_accel : kNone, [&](const auto& s) {
+                // The grid, once refined for this TF, bounds the pixels that can see anything
+                // (render/screen_cover.h); the rest are written empty without marching.
+                std::optional<ScreenCover> cover;
+                if constexpr (std::is_same_v<std::remove_cvref_t<decltype(s)>, BrickGrid>)
+                    cover = ScreenCover::build(s, m_volume, cam);
+                const ScreenCover* cv = cover ? &*cover : nullptr;
                 auto frame = [&](auto nearest) {
                     parallel_for_tiles(cam.width(), cam.height(), opt.tile, opt.threads,
                                        [&](int x0, int y0, int x1, int y1) {
                                            render_tile_on<T, decltype(nearest)::value>(
                                                isa, small, s, m_volume, data, cam, opt, lut, map,
-                                               x0, y0, x1, y1, out, samples, rays);
+                                               x0, y0, x1, y1, out, samples, rays, cv);
                                        });
                 };
                 if (opt.interpolation == Interpolation::Nearest)
