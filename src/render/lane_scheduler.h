@@ -148,12 +148,19 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                 const float t_base = policy.t_base(x, y, t_near);
                 const int k_end = lattice_end(t_base, t_far, dt);
                 bool run;
+                // Inside the cover, only the depth its boxes allow (screen_cover.h, "Depth").
+                float t0 = t_near, t1 = t_far;
+                if (cover) {
+                    float c0, c1;
+                    cover->depth(x, y, c0, c1);
+                    t0 = std::max(t0, c0 - dt), t1 = std::min(t1, c1 + dt);
+                }
                 if constexpr (kWhole) {
-                    lattice_run(Segment{t_near, t_far}, t_base, inv_dt, 0, k_end, kb, ke);
-                    run = 0 < k_end && ke > kb;
+                    lattice_run(Segment{t0, t1}, t_base, inv_dt, 0, k_end, kb, ke);
+                    run = 0 < k_end && ke > kb && t0 < t1;
                 } else {
                     sl.runs.reset();
-                    sl.cursor.emplace(accel, r, t_near, t_far, dt, chunk);
+                    sl.cursor.emplace(accel, r, t0, std::max(t0, t1), dt, chunk);
                     sl.runs.emplace(*sl.cursor, t_base, dt, k_end);
                     run = sl.runs->next(kb, ke);
                 }

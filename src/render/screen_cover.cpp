@@ -75,6 +75,13 @@ std::optional<ScreenCover> ScreenCover::build(const BrickGrid& grid, const Volum
     c.m_width = cam.width(), c.m_height = cam.height();
     c.m_words = (size_t(c.m_width) + 63) / 64;
     c.m_bits.assign(c.m_words * size_t(c.m_height), 0);
+    c.m_bw = (c.m_width + 7) / 8;
+    const size_t blocks = size_t(c.m_bw) * size_t((c.m_height + 7) / 8);
+    c.m_t0.assign(blocks, INFINITY);
+    c.m_t1.assign(blocks, -INFINITY);
+    const Vec3f eye_f = cam.eye();
+    const double eye[3] = {eye_f.x, eye_f.y, eye_f.z};
+    const double sp[3] = {vol.spacing.x, vol.spacing.y, vol.spacing.z};
     auto box = [&](const double lo[3], const double up[3]) {
         // Each form at a corner is its constant plus one term per axis, lo or up: 18 products.
         double t[3][3][2];
@@ -82,10 +89,12 @@ std::optional<ScreenCover> ScreenCover::build(const BrickGrid& grid, const Volum
             for (int a = 0; a < 3; ++a)
                 t[k][a][0] = f.c[k][a] * lo[a], t[k][a][1] = f.c[k][a] * up[a];
         double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+        double s0 = INFINITY, s1 = -INFINITY;
         for (int i = 0; i < 8; ++i) {
             const int u = i & 1, v = i >> 1 & 1, w = i >> 2;
             const double s = f.c[0][3] + t[0][0][u] + t[0][1][v] + t[0][2][w];
             if (!(s > s_min)) return false;
+            s0 = std::min(s0, s), s1 = std::max(s1, s);
             const double q = ortho ? 1.0 : 1.0 / s;
             const double sx = (f.c[1][3] + t[1][0][u] + t[1][1][v] + t[1][2][w]) * q;
             const double sy = (f.c[2][3] + t[2][0][u] + t[2][1][v] + t[2][2][w]) * q;
@@ -94,9 +103,23 @@ std::optional<ScreenCover> ScreenCover::build(const BrickGrid& grid, const Volum
             x0 = std::min(x0, px), x1 = std::max(x1, px);
             y0 = std::min(y0, py), y1 = std::max(y1, py);
         }
+        // The box's t range: orthographic t is the depth s (a unit forward); perspective t is the
+        // distance from the eye, between the box's nearest point and its farthest corner.
+        double t0 = s0, t1 = s1;
+        if (!ortho) {
+            double n2 = 0, f2 = 0;
+            for (int a = 0; a < 3; ++a) {
+                const double l = lo[a] * sp[a] - eye[a], h = up[a] * sp[a] - eye[a];
+                const double near = l > 0 ? l : (h < 0 ? -h : 0);
+                const double far = std::max(std::fabs(l), std::fabs(h));
+                n2 += near * near, f2 += far * far;
+            }
+            t0 = std::sqrt(n2), t1 = std::sqrt(f2);
+        }
         const double big = 1e9;  // clamp before the int conversion; mark() clips to the image
         c.mark(int(std::floor(std::max(x0, -big))) - 1, int(std::floor(std::max(y0, -big))) - 1,
-               int(std::ceil(std::min(x1, big))) + 1, int(std::ceil(std::min(y1, big))) + 1);
+               int(std::ceil(std::min(x1, big))) + 1, int(std::ceil(std::min(y1, big))) + 1,
+               float(t0 * (1 - 1e-6)), float(t1 * (1 + 1e-6)));
         return true;
     };
     // Orthographic rays start on the eye plane: the whole grown grid in front of it.
@@ -122,10 +145,15 @@ std::optional<ScreenCover> ScreenCover::build(const BrickGrid& grid, const Volum
     return c;
 }
 
-void ScreenCover::mark(int x0, int y0, int x1, int y1) {
+void ScreenCover::mark(int x0, int y0, int x1, int y1, float t0, float t1) {
     x0 = std::max(x0, 0), y0 = std::max(y0, 0);
     x1 = std::min(x1, m_width - 1), y1 = std::min(y1, m_height - 1);
     if (x0 > x1 || y0 > y1) return;
+    for (int by = y0 >> 3; by <= y1 >> 3; ++by)
+        for (int bx = x0 >> 3; bx <= x1 >> 3; ++bx) {
+            const size_t b = size_t(by) * size_t(m_bw) + size_t(bx);
+            m_t0[b] = std::min(m_t0[b], t0), m_t1[b] = std::max(m_t1[b], t1);
+        }
     const int w0 = x0 >> 6, w1 = x1 >> 6;
     for (int y = y0; y <= y1; ++y) {
         uint64_t* row = &m_bits[size_t(y) * m_words];

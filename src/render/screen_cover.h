@@ -24,6 +24,15 @@
 // projection, so the pixel is marked. An unmarked pixel's ray therefore has no visible sample,
 // and its accumulated colour is exactly zero (zero-opacity entries are zero in every channel,
 // ray_marcher.cpp step_corrected_lut): the empty pixel, with zero samples.
+//
+// Depth. The same argument bounds where along a covered ray its visible samples can be: every
+// point of the boundary of U_m is within m of a surface brick (a point within m of a brick whose
+// 26 neighbours are occupied is inside U_m), and the first and the last point of U_m on the ray
+// are boundary points. So every visible sample's t lies between the nearest and the farthest
+// point of the grown surface boxes the ray meets, and those boxes all reach the pixel's block.
+// The marcher takes the lattice samples of [t0 - dt, t1 + dt] within the ray's box, still on the
+// ray's own lattice (anchored at its entry, pixel_driver.h lattice_run rounds outward), so the
+// samples it leaves out before and after are invisible, and the composite is unchanged.
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -46,6 +55,13 @@ class ScreenCover {
     bool covered(int x, int y) const {
         return (m_bits[size_t(y) * m_words + size_t(x >> 6)] >> (x & 63)) & 1u;
     }
+    // Bounds on the ray parameter (world units, as the marcher's t) of every visible sample of a
+    // covered pixel's ray: per block of 8x8 pixels, the nearest and farthest point of the grown
+    // surface boxes whose rectangles reach the block (the depth argument above).
+    void depth(int x, int y, float& t0, float& t1) const {
+        const size_t b = size_t(y >> 3) * size_t(m_bw) + size_t(x >> 3);
+        t0 = m_t0[b], t1 = m_t1[b];
+    }
     // Whether any pixel of [x0, x1) x [y0, y1) is covered.
     bool any(int x0, int y0, int x1, int y1) const;
     // The share of the image's pixels that are covered (benchmarks, tests).
@@ -54,9 +70,10 @@ class ScreenCover {
     int height() const { return m_height; }
 
   private:
-    void mark(int x0, int y0, int x1, int y1);  // inclusive, clipped
-    int m_width = 0, m_height = 0;
-    size_t m_words = 0;  // per row
+    void mark(int x0, int y0, int x1, int y1, float t0, float t1);  // inclusive, clipped
+    int m_width = 0, m_height = 0, m_bw = 0;
+    std::vector<float> m_t0, m_t1;  // per 8x8 block
+    size_t m_words = 0;             // per row
     std::vector<uint64_t> m_bits;
 };
 
