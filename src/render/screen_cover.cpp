@@ -116,10 +116,12 @@ std::optional<ScreenCover> ScreenCover::build(const BrickGrid& grid, const Volum
             }
             t0 = std::sqrt(n2), t1 = std::sqrt(f2);
         }
-        const double big = 1e9;  // clamp before the int conversion; mark() clips to the image
-        c.mark(int(std::floor(std::max(x0, -big))) - 1, int(std::floor(std::max(y0, -big))) - 1,
-               int(std::ceil(std::min(x1, big))) + 1, int(std::ceil(std::min(y1, big))) + 1,
-               float(t0 * (1 - 1e-6)), float(t1 * (1 + 1e-6)));
+        // Clamped before the int conversion (a box far off screen projects anywhere); mark()
+        // clips to the image.
+        auto px_lo = [](double v) { return int(std::floor(std::clamp(v, -1e9, 1e9))) - 1; };
+        auto px_hi = [](double v) { return int(std::ceil(std::clamp(v, -1e9, 1e9))) + 1; };
+        c.mark(px_lo(x0), px_lo(y0), px_hi(x1), px_hi(y1), float(t0 * (1 - 1e-6)),
+               float(t1 * (1 + 1e-6)));
         return true;
     };
     // Orthographic rays start on the eye plane: the whole grown grid in front of it.
