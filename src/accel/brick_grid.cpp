@@ -172,13 +172,16 @@ std::vector<int> chebyshev_distances(const int n[3], Occupied&& occupied) {
 //     S(b) = occupied(b) ? 0 : min(kCap, 1 + min_delta S(b + s delta)),
 // swept against s, in a copy of the grid flipped to s = +1 with one plane of kCap past its
 // far faces. `near` holds octant 0's layout: low byte 0 where occupied, high byte the
-// sub-bricks (copied into every octant). One octant per task.
+// sub-bricks (copied into every octant). The inside distances of the fully visible bricks
+// (high byte 0xff) follow the same recurrence with "fully visible" for "empty", swept in a
+// second copy whose plane past the far faces is 0. One octant per task.
 static void octant_distances(const int nf[3], const uint16_t* near, int threads, uint16_t* leap) {
     const int nx = nf[0], ny = nf[1], nz = nf[2];
     const size_t n = size_t(nx) * size_t(ny) * size_t(nz);
     const size_t px = size_t(nx) + 1, pxy = px * (size_t(ny) + 1);
     parallel_for(8, threads, [&](size_t o0, size_t o1) {
         std::vector<uint8_t> s(pxy * (size_t(nz) + 1), uint8_t(kCap));
+        std::vector<uint8_t> f(pxy * (size_t(nz) + 1), uint8_t(0));  // inside distances
         for (size_t o = o0; o < o1; ++o) {
             const bool neg[3] = {bool(o & 1), bool(o & 2), bool(o & 4)};
             for (int z = nz - 1; z >= 0; --z)
@@ -186,22 +189,32 @@ static void octant_distances(const int nf[3], const uint16_t* near, int threads,
                     // (x, y, z) in the flipped copy is brick (fx, fy, fz) of the grid
                     const int fy = neg[1] ? ny - 1 - y : y, fz = neg[2] ? nz - 1 - z : z;
                     const size_t row = (size_t(fz) * size_t(ny) + size_t(fy)) * size_t(nx);
-                    uint8_t* c = s.data() + size_t(z) * pxy + size_t(y) * px;
+                    const size_t at = size_t(z) * pxy + size_t(y) * px;
+                    uint8_t* c = s.data() + at;
                     const uint8_t* cy = c + px;
                     const uint8_t* cz = c + pxy;
                     const uint8_t* cyz = cz + px;
+                    uint8_t* g = f.data() + at;
+                    const uint8_t* gy = g + px;
+                    const uint8_t* gz = g + pxy;
+                    const uint8_t* gyz = gz + px;
                     uint16_t* out = leap + o * n + row;
                     for (int x = nx - 1; x >= 0; --x) {
                         const int fx = neg[0] ? nx - 1 - x : x;
                         const uint16_t e = near[row + size_t(fx)];
-                        int d = 0;
+                        int d = 0, in = 0;
                         if (e & 0xff) {
                             int m = std::min(
                                 {c[x + 1], cy[x], cy[x + 1], cz[x], cz[x + 1], cyz[x], cyz[x + 1]});
                             d = std::min(kCap, m + 1);
+                        } else if ((e & 0xff00) == 0xff00) {
+                            int m = std::min(
+                                {g[x + 1], gy[x], gy[x + 1], gz[x], gz[x + 1], gyz[x], gyz[x + 1]});
+                            in = std::min(kCap, m + 1);
                         }
                         c[x] = uint8_t(d);
-                        out[fx] = uint16_t((e & 0xff00) | unsigned(d));
+                        g[x] = uint8_t(in);
+                        out[fx] = uint16_t((e & 0xff00) | unsigned(d | in));
                     }
                 }
         }

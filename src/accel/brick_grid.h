@@ -72,6 +72,11 @@ class BrickGrid final : public OctreeBase {
     //     axis), holds a cell of the visible-cell mask (bits of sub-bricks past the grid, which
     //     hold no sample's cell, are free). A ray in a clear sub-brick may skip every sample
     //     before it leaves that sub-brick, by the same argument.
+    //   Where every sub-brick is set (high byte 0xff, "fully visible"), the low byte is instead
+    //     the inside distance: the largest e for which every brick of the box reaching e - 1
+    //     bricks toward the octant is fully visible (bricks past the grid are not; so e >= 1).
+    //     Nothing is skipped there; the leaping kernels take the box's samples without testing
+    //     each one (core/simd_lanes.h, Group16). So a reader skips on d >= 1 only below 0xff.
     static constexpr int kLeapLog2 = 2;
     const uint16_t* leap_map() const { return m_mask_ready ? m_leap.data() : nullptr; }
     const int* leap_dims() const { return m_nf; }

@@ -170,6 +170,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
                     L.dx[l] = r.dx, L.dy[l] = r.dy, L.dz[l] = r.dz;
                     L.t_base[l] = t_base;
                     L.k[l] = kb, L.kend[l] = ke;
+                    L.kcheck[l] = kb;
                     L.r[l] = L.g[l] = L.b[l] = L.a[l] = 0.f;
                     L.n[l] = 0;
                     L.active[l] = -1;
@@ -191,6 +192,7 @@ void schedule_tile_lanes(const S& accel, const Volume& vol, const Camera& cam, f
             int kb, ke;
             if (!kWhole && !(L.a[l] >= ert) && slot[l].runs->next(kb, ke)) {
                 L.k[l] = kb, L.kend[l] = ke;
+                L.kcheck[l] = kb;
                 continue;
             }
             policy.finish(l, slot[l].x, slot[l].y, L);

@@ -147,7 +147,7 @@ TEST(BrickGrid, RefinedCellMaskIsTheVisibilityOfEveryCellsRange) {
 // (sub-bricks past the grid are free).
 TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
     Rng rng{9109};
-    int near = 0, far = 0, sub_set = 0, sub_clear = 0, longer = 0;
+    int near = 0, far = 0, sub_set = 0, sub_clear = 0, longer = 0, full = 0, longer_inside = 0;
     for (int trial = 0; trial < 40; ++trial) {
         const Volume v = random_volume(kAllTypes[trial % 4], random_dims(rng, 2, 40), rng);
         AccelOptions o;
@@ -212,8 +212,32 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
                                     want = std::min(want, std::max({u, w, t}));
                                 }
                         const uint16_t eo = leap[o * stride + id];
-                        ASSERT_EQ(eo & 0xff, want) << describe(v, lut) << " fine brick " << x << ","
-                                                   << y << "," << z << " octant " << o;
+                        if (want == 0 && (eo >> 8) == 0xff) {
+                            // A fully visible brick: the inside distance, the side of the
+                            // largest box toward the octant of fully visible bricks (past the
+                            // grid counts as not fully visible).
+                            int inside =
+                                std::min({sx > 0 ? nf[0] - x : x + 1, sy > 0 ? nf[1] - y : y + 1,
+                                          sz > 0 ? nf[2] - z : z + 1, 255});
+                            for (int c = 0; c < nf[2]; ++c)
+                                for (int b = 0; b < nf[1]; ++b)
+                                    for (int a = 0; a < nf[0]; ++a) {
+                                        const int u = sx * (a - x), w = sy * (b - y),
+                                                  t = sz * (c - z);
+                                        if (u < 0 || w < 0 || t < 0 ||
+                                            leap[(size_t(c) * nf[1] + b) * nf[0] + a] >> 8 == 0xff)
+                                            continue;
+                                        inside = std::min(inside, std::max({u, w, t}));
+                                    }
+                            ASSERT_EQ(eo & 0xff, inside)
+                                << describe(v, lut) << " fine brick " << x << "," << y << "," << z
+                                << " octant " << o << ": inside distance";
+                            ++full;
+                            longer_inside += inside > 1;
+                        } else {
+                            ASSERT_EQ(eo & 0xff, want) << describe(v, lut) << " fine brick " << x
+                                                       << "," << y << "," << z << " octant " << o;
+                        }
                         ASSERT_EQ(eo >> 8, leap[id] >> 8)
                             << "the sub-bricks are the same in every octant";
                         wants[o] = want;
@@ -247,6 +271,8 @@ TEST(BrickGrid, LeapMapIsTheDistanceToVisibleBricksAndTheVisibleSubBricks) {
     EXPECT_GT(sub_set, 500);
     EXPECT_GT(sub_clear, 200);
     EXPECT_GT(longer, 200) << "octant maps that see farther than the symmetric distance";
+    EXPECT_GT(full, 5000) << "fully visible bricks";
+    EXPECT_GT(longer_inside, 2000) << "boxes of fully visible bricks";
 }
 
 // Zero everywhere but a few random voxels: empty blocks to leap over.
