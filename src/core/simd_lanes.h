@@ -622,7 +622,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
                  vlast = _mm256_set1_ps(g.lut_last);
     const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
     __m256 ox, oy, oz, dx, dy, dz, tb, ar, ag, ab, aa;
-    __m256i kend, active, k, n;
+    __m256i kend, active, k, n, kcheck = _mm256_setzero_si256();
 #define LACUNA_LOAD_LANES                                                            \
     ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz); \
     dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz); \
@@ -634,7 +634,10 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
     ar = _mm256_load_ps(s.r), ag = _mm256_load_ps(s.g), ab = _mm256_load_ps(s.b);    \
     aa = _mm256_load_ps(s.a);                                                        \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                   \
-    if constexpr (kLeap) leap_inverse8(dx, dy, dz, g.leap_octant, linv);
+    if constexpr (kLeap) {                                                           \
+        leap_inverse8(dx, dy, dz, g.leap_octant, linv);                              \
+        kcheck = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kcheck));      \
+    }
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
     int active_mask, waiting = 0;
@@ -652,9 +655,19 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
             v = nearest8(g, data, x, y, z);
         else
             v = trilinear8(g, data, x, y, z);
-        // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead.
+        // Leaping: the lanes whose sample lies in an empty fine brick skip ahead instead; the
+        // test only when a valid lane has left its box of fully visible bricks (kcheck, as in
+        // march_lanes16's Group16).
         __m256i taken = valid, adv = _mm256_set1_epi32(1);
-        if constexpr (kLeap) leap8(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        if constexpr (kLeap) {
+            const __m256i test = _mm256_andnot_si256(_mm256_cmpgt_epi32(kcheck, k), valid);
+            if (!_mm256_testz_si256(test, test)) {
+                __m256i inside;
+                leap8(g, x, y, z, valid, inv_dt, linv, taken, adv, &inside);
+                kcheck = _mm256_blendv_epi8(kcheck, _mm256_add_epi32(k, inside),
+                                            _mm256_cmpgt_epi32(inside, _mm256_setzero_si256()));
+            }
+        }
         if constexpr (!kNearest) prefetch_ahead8(g, data, t, ox, oy, oz, dx, dy, dz, taken);
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
@@ -703,6 +716,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
             _mm256_store_ps(s.g, ag);
             _mm256_store_ps(s.b, ab);
             _mm256_store_ps(s.a, aa);
+            if constexpr (kLeap) _mm256_store_si256(reinterpret_cast<__m256i*>(s.kcheck), kcheck);
             if (!refill(need)) return;
             LACUNA_LOAD_LANES
         }
@@ -841,6 +855,12 @@ LACUNA_AVX512 inline __attribute__((always_inline)) __m512 trilinear16(const G& 
     const __m512 c1 = _mm512_add_ps(c01, _mm512_mul_ps(fy, _mm512_sub_ps(c11, c01)));
     return _mm512_add_ps(c0, _mm512_mul_ps(fz, _mm512_sub_ps(c1, c0)));
 }
+
+// Leaping kernels, integer voxels: with few lanes taking a sample, only theirs load corners
+// (one by one, trilinear16's kSparse); with kDenseLoads or more, all sixteen load without the
+// per-lane branches (the others at voxel 0), 5% faster on ch2 inside the head and no slower on
+// the sparse tree (docs/benchmarks.md, fifteenth session).
+inline constexpr int kDenseLoads = 4;
 
 // Leaping, sixteen lanes: leap8's operations on positions already clamped into [0, hi].
 LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(
@@ -1047,11 +1067,6 @@ struct Group16 {
                 kcheck = _mm512_mask_add_epi32(kcheck, full, k, inside);
             }
             prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);
-            // Integer voxels: with few lanes taken, only theirs load corners (one by one); with
-            // kDenseLoads or more, all sixteen load without the per-lane branches (the others at
-            // voxel 0), which measured 5% faster on ch2 inside the head and no slower on the
-            // sparse tree (docs/benchmarks.md, fifteenth session).
-            constexpr int kDenseLoads = 4;
             if (std::is_integral_v<T> && __builtin_popcount(taken) >= kDenseLoads)
                 v = trilinear16<T, LaneGrid, false>(g, data, x, y, z, taken);
             else

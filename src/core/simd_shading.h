@@ -825,7 +825,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
 template <class T>
 struct ShadedGroup16 {
     __m512 ox, oy, oz, dx, dy, dz, tb, aa;
-    __m512i kend, k, n, vrec;
+    __m512i kend, k, n, vrec, kcheck;
     __mmask16 active;
 
     LACUNA_AVX512 inline __attribute__((always_inline)) void load(const Lanes& s, int b,
@@ -839,6 +839,7 @@ struct ShadedGroup16 {
         active = _mm512_cmpneq_epi32_mask(_mm512_load_si512(s.active + b), _mm512_setzero_si512());
         k = _mm512_load_si512(s.k + b);
         n = _mm512_load_si512(s.n + b);
+        kcheck = _mm512_load_si512(s.kcheck + b);
         aa = _mm512_load_ps(s.a + b);
         vrec = _mm512_loadu_si512(rec + b);  // the lanes' records (a refill may change them)
         leap_inverse16(dx, dy, dz, g.leap_octant, li, b);
@@ -847,6 +848,7 @@ struct ShadedGroup16 {
         _mm512_store_si512(s.kend + b, kend);
         _mm512_store_si512(s.k + b, k);
         _mm512_store_si512(s.n + b, n);
+        _mm512_store_si512(s.kcheck + b, kcheck);
         _mm512_store_ps(s.a + b, aa);
     }
     // One sample (or leap) per valid lane, its visible samples queued; returns the active lanes
@@ -866,13 +868,23 @@ struct ShadedGroup16 {
         const __m512 x = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[0]), px));
         const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), py));
         const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), pz));
-        __mmask16 taken;
-        __m512i adv;
-        leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b);
+        // The leap test only when a valid lane has left its box of fully visible bricks
+        // (march_lanes16's Group16, kcheck).
+        __mmask16 taken = valid;
+        __m512i adv = ione;
+        if (_mm512_cmpge_epi32_mask(k, kcheck) & valid) {
+            __mmask16 full;
+            __m512i inside;
+            leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b, &full,
+                   &inside);
+            kcheck = _mm512_mask_add_epi32(kcheck, full, k, inside);
+        }
         prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);  // (simd_lanes.h)
-        // (only the lanes that take their sample load its corners: trilinear16's kSparse)
-        const __m512 v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
-            g, data, x, y, z, std::is_integral_v<T> ? taken : active);
+        // (few lanes taking their sample: only theirs load its corners, trilinear16's kSparse)
+        const __m512 v = std::is_integral_v<T> && __builtin_popcount(taken) >= kDenseLoads
+                             ? trilinear16<T, LaneGrid, false>(g, data, x, y, z, taken)
+                             : trilinear16<T, LaneGrid, std::is_integral_v<T>>(
+                                   g, data, x, y, z, std::is_integral_v<T> ? taken : active);
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)),
                                                _mm512_set1_ps(g.lut_scale)),
                                  half);
