@@ -739,7 +739,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
                  vlast = _mm256_set1_ps(g.lut_last);
     const __m256i vzero_entry = _mm256_set1_epi32(g.zero_entry);
     __m256 ox, oy, oz, dx, dy, dz, tb, aa;
-    __m256i kend, active, k, n;
+    __m256i kend, active, k, n, kcheck = _mm256_setzero_si256();
 #define LACUNA_LOAD_LANES                                                            \
     ox = _mm256_load_ps(s.ox), oy = _mm256_load_ps(s.oy), oz = _mm256_load_ps(s.oz); \
     dx = _mm256_load_ps(s.dx), dy = _mm256_load_ps(s.dy), dz = _mm256_load_ps(s.dz); \
@@ -750,7 +750,10 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
     n = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.n));                    \
     aa = _mm256_load_ps(s.a);                                                        \
     active_mask = _mm256_movemask_ps(_mm256_castsi256_ps(active));                   \
-    if constexpr (kLeap) leap_inverse8(dx, dy, dz, g.leap_octant, linv);
+    if constexpr (kLeap) {                                                           \
+        leap_inverse8(dx, dy, dz, g.leap_octant, linv);                              \
+        kcheck = _mm256_load_si256(reinterpret_cast<const __m256i*>(s.kcheck));      \
+    }
     LeapInverse linv;  // leaping: 1 / dir per lane
     const __m256 inv_dt = _mm256_set1_ps(1.f / g.dt);
     int active_mask, waiting = 0;
@@ -764,8 +767,18 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
         const __m256 y = _mm256_add_ps(oy, _mm256_mul_ps(t, dy));
         const __m256 z = _mm256_add_ps(oz, _mm256_mul_ps(t, dz));
         const __m256 v = trilinear8(g, data, x, y, z);
+        // The leap test only when a valid lane has left its box of fully visible bricks
+        // (kcheck, as in march_lanes8).
         __m256i taken = valid, adv = _mm256_set1_epi32(1);
-        if constexpr (kLeap) leap8(g, x, y, z, valid, inv_dt, linv, taken, adv);
+        if constexpr (kLeap) {
+            const __m256i test = _mm256_andnot_si256(_mm256_cmpgt_epi32(kcheck, k), valid);
+            if (!_mm256_testz_si256(test, test)) {
+                __m256i inside;
+                leap8(g, x, y, z, valid, inv_dt, linv, taken, adv, &inside);
+                kcheck = _mm256_blendv_epi8(kcheck, _mm256_add_epi32(k, inside),
+                                            _mm256_cmpgt_epi32(inside, _mm256_setzero_si256()));
+            }
+        }
         prefetch_ahead8(g, data, t, ox, oy, oz, dx, dy, dz, taken);  // (simd_lanes.h)
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
@@ -804,6 +817,7 @@ LACUNA_AVX2 void march_shaded_lanes8(Lanes& s, const LaneGrid& g, const T* data,
             _mm256_store_si256(reinterpret_cast<__m256i*>(s.k), k);
             _mm256_store_si256(reinterpret_cast<__m256i*>(s.n), n);
             _mm256_store_ps(s.a, aa);
+            if constexpr (kLeap) _mm256_store_si256(reinterpret_cast<__m256i*>(s.kcheck), kcheck);
             if (!refill(need)) return;
             LACUNA_LOAD_LANES
         }
