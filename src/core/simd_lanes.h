@@ -36,6 +36,10 @@
 // sub-bricks of 2^3 cells (with their own one-cell apron) may read a visible entry; in a clear
 // one the lane leaves that sub-brick the same way, with edge 2 and D = 1:
 //     face_a = (c_a & -2) + (dir_a < 0 ? 0 : 2).
+// A high byte of 0xff (every sub-brick set, "fully visible") turns the low byte into the inside
+// distance e >= 1: nothing is skipped, and the same face formula with D = e gives kcheck, the
+// first sample past the box of fully visible bricks, before which the group needs no test
+// (Group16; only a skip needs the test, so kcheck cannot change a bit of the image).
 // Why this is exact. (1) Clamping only helps: where the clamped trajectory differs from the ray
 // it stays on the volume's boundary, which moves it no faster toward a face ahead than q + t dir
 // does, and never backward (each coordinate, o_a + t dir_a rounded then clamped, is monotone in
