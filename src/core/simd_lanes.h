@@ -575,6 +575,21 @@ LACUNA_AVX2 inline __attribute__((always_inline)) void leap8(const LaneGrid& g, 
     if (inside) *inside = _mm256_and_si256(_mm256_and_si256(full, valid), leap);
 }
 
+// The leap test only where it may skip: when a valid lane has reached its kcheck (the first
+// sample past its box of fully visible bricks, see "Leaping" above); a test that finds a lane
+// in a fully visible brick moves that lane's kcheck past the new box. Otherwise taken and adv
+// stay as given (every valid lane takes its sample).
+LACUNA_AVX2 inline __attribute__((always_inline)) void leap8_outside(
+    const LaneGrid& g, __m256 x, __m256 y, __m256 z, __m256i valid, __m256 inv_dt,
+    const LeapInverse& li, __m256i k, __m256i& kcheck, __m256i& taken, __m256i& adv) {
+    const __m256i test = _mm256_andnot_si256(_mm256_cmpgt_epi32(kcheck, k), valid);
+    if (_mm256_testz_si256(test, test)) return;
+    __m256i inside;
+    leap8(g, x, y, z, valid, inv_dt, li, taken, adv, &inside);
+    kcheck = _mm256_blendv_epi8(kcheck, _mm256_add_epi32(k, inside),
+                                _mm256_cmpgt_epi32(inside, _mm256_setzero_si256()));
+}
+
 // Prefetch: a ray's samples walk through the volume at half a voxel per step, each step in
 // other voxel rows, in an order no hardware prefetcher follows; once the volume outgrows the
 // caches (ch2better, 35 MB; tree512, 128 MB) a step waits on its corner rows. Each lane that
@@ -663,15 +678,7 @@ LACUNA_AVX2 void march_lanes8(Lanes& s, const LaneGrid& g, const T* data, const 
         // test only when a valid lane has left its box of fully visible bricks (kcheck, as in
         // march_lanes16's Group16).
         __m256i taken = valid, adv = _mm256_set1_epi32(1);
-        if constexpr (kLeap) {
-            const __m256i test = _mm256_andnot_si256(_mm256_cmpgt_epi32(kcheck, k), valid);
-            if (!_mm256_testz_si256(test, test)) {
-                __m256i inside;
-                leap8(g, x, y, z, valid, inv_dt, linv, taken, adv, &inside);
-                kcheck = _mm256_blendv_epi8(kcheck, _mm256_add_epi32(k, inside),
-                                            _mm256_cmpgt_epi32(inside, _mm256_setzero_si256()));
-            }
-        }
+        if constexpr (kLeap) leap8_outside(g, x, y, z, valid, inv_dt, linv, k, kcheck, taken, adv);
         if constexpr (!kNearest) prefetch_ahead8(g, data, t, ox, oy, oz, dx, dy, dz, taken);
         __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(v, voff), vscale), half);
         u = _mm256_max_ps(zero, _mm256_min_ps(vlast, u));
@@ -919,6 +926,34 @@ LACUNA_AVX512 inline __attribute__((always_inline)) void leap16(
     adv = _mm512_mask_blend_epi32(skip, ione, leap);
     if (full_lanes) *full_lanes = valid & full, *inside = leap;
 }
+
+// leap8_outside for sixteen lanes.
+LACUNA_AVX512 inline __attribute__((always_inline)) void leap16_outside(
+    const LaneGrid& g, __m512 x, __m512 y, __m512 z, __mmask16 valid, const LeapInverse& li, int b,
+    __m512i k, __m512i& kcheck, __mmask16& taken, __m512i& adv) {
+    if (!(_mm512_cmpge_epi32_mask(k, kcheck) & valid)) return;
+    __mmask16 full;
+    __m512i inside;
+    leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b, &full, &inside);
+    kcheck = _mm512_mask_add_epi32(kcheck, full, k, inside);
+}
+
+// The leaping kernels' trilinear values of the lanes in `taken` (kDenseLoads); float voxels
+// load every active lane (gathers).
+template <class T>
+LACUNA_AVX512 inline __attribute__((always_inline)) __m512 leap_trilinear16(const LaneGrid& g,
+                                                                            const T* data, __m512 x,
+                                                                            __m512 y, __m512 z,
+                                                                            __mmask16 taken,
+                                                                            __mmask16 active) {
+    if constexpr (std::is_integral_v<T>) {
+        if (__builtin_popcount(taken) >= kDenseLoads)
+            return trilinear16<T, LaneGrid, false>(g, data, x, y, z, taken);
+        return trilinear16<T, LaneGrid, true>(g, data, x, y, z, taken);
+    } else {
+        return trilinear16<T, LaneGrid, false>(g, data, x, y, z, active);
+    }
+}
 // leap_inverse8's clamped 1 / dir, sixteen lanes.
 LACUNA_AVX512 inline __attribute__((always_inline)) void leap_inverse16(__m512 dx, __m512 dy,
                                                                         __m512 dz, int32_t stride,
@@ -1062,20 +1097,9 @@ struct Group16 {
         __mmask16 taken = valid;
         __m512i adv = ione;
         if constexpr (kLeap) {
-            const bool tested = _mm512_cmpge_epi32_mask(k, kcheck) & valid;
-            if (tested) {
-                __mmask16 full;
-                __m512i inside;
-                leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b, &full,
-                       &inside);
-                kcheck = _mm512_mask_add_epi32(kcheck, full, k, inside);
-            }
+            leap16_outside(g, x, y, z, valid, li, b, k, kcheck, taken, adv);
             prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);
-            if (std::is_integral_v<T> && __builtin_popcount(taken) >= kDenseLoads)
-                v = trilinear16<T, LaneGrid, false>(g, data, x, y, z, taken);
-            else
-                v = trilinear16<T, LaneGrid, std::is_integral_v<T>>(
-                    g, data, x, y, z, std::is_integral_v<T> ? taken : active);
+            v = leap_trilinear16(g, data, x, y, z, taken, active);
         }
         // A step on which every lane leaps composites nothing (their entries would be the
         // zero entry, which adds exact zeros): the LUT loads are skipped.

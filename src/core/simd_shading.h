@@ -883,22 +883,12 @@ struct ShadedGroup16 {
         const __m512 y = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[1]), py));
         const __m512 z = _mm512_max_ps(zero, _mm512_min_ps(_mm512_set1_ps(g.hi[2]), pz));
         // The leap test only when a valid lane has left its box of fully visible bricks
-        // (march_lanes16's Group16, kcheck).
+        // (simd_lanes.h leap16_outside), and the corner loads as in march_lanes16.
         __mmask16 taken = valid;
         __m512i adv = ione;
-        if (_mm512_cmpge_epi32_mask(k, kcheck) & valid) {
-            __mmask16 full;
-            __m512i inside;
-            leap16(g, x, y, z, valid, _mm512_set1_ps(1.f / g.dt), li, taken, adv, b, &full,
-                   &inside);
-            kcheck = _mm512_mask_add_epi32(kcheck, full, k, inside);
-        }
+        leap16_outside(g, x, y, z, valid, li, b, k, kcheck, taken, adv);
         prefetch_ahead16(g, data, t, ox, oy, oz, dx, dy, dz, taken);  // (simd_lanes.h)
-        // (few lanes taking their sample: only theirs load its corners, trilinear16's kSparse)
-        const __m512 v = std::is_integral_v<T> && __builtin_popcount(taken) >= kDenseLoads
-                             ? trilinear16<T, LaneGrid, false>(g, data, x, y, z, taken)
-                             : trilinear16<T, LaneGrid, std::is_integral_v<T>>(
-                                   g, data, x, y, z, std::is_integral_v<T> ? taken : active);
+        const __m512 v = leap_trilinear16(g, data, x, y, z, taken, active);
         __m512 u = _mm512_add_ps(_mm512_mul_ps(_mm512_sub_ps(v, _mm512_set1_ps(g.lut_offset)),
                                                _mm512_set1_ps(g.lut_scale)),
                                  half);
