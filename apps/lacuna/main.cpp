@@ -56,9 +56,16 @@ void add_quiet(CLI::App& app) {
     for (CLI::App* s : app.get_subcommands([](const CLI::App*) { return true; })) add_quiet(*s);
 }
 
-// Under mpirun every rank parses the same flags and fails alike: rank 0 alone prints the line.
-void error_line(const std::string& line) {
-    if (lacuna::dist::launcher_rank() == 0) std::fprintf(stderr, "lacuna: %s\n", line.c_str());
+// Under mpirun every rank parses the same flags and fails alike: rank 0 alone prints the line
+// and alone ends with the failure's code; the other ranks end with 0. mpirun's status is then
+// rank 0's, and rank 0's line always reaches the terminal: when a rank other than 0 ended with
+// a non-zero code first, mpirun aborted the job and could drop rank 0's line, still in its pipe.
+// (A failure of one rank alone never gets here: it ends the job with its own line and
+// MPI_Abort, src/dist.)
+int fail(const std::string& line, int code) {
+    if (lacuna::dist::launcher_rank() != 0) return 0;
+    std::fprintf(stderr, "lacuna: %s\n", line.c_str());
+    return code;
 }
 
 }  // namespace
@@ -84,21 +91,17 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        error_line(std::string(e.what()) + " (see --help)");
-        return 2;
+        return fail(std::string(e.what()) + " (see --help)", 2);
     } catch (const lacuna::FrameError& e) {
         // The library names FrameSpec fields; the user typed flags (frame_flags.cpp).
-        error_line(lacuna::cli::flag_of_field(e.field()) + ": " + e.field() + ": " + e.expected());
-        return 2;
+        return fail(lacuna::cli::flag_of_field(e.field()) + ": " + e.field() + ": " + e.expected(),
+                    2);
     } catch (const lacuna::Error& e) {
-        error_line(lacuna::cli::with_flag(e.what()));
-        return 2;
+        return fail(lacuna::cli::with_flag(e.what()), 2);
     } catch (const std::bad_alloc&) {
-        error_line("out of memory");
-        return 2;
+        return fail("out of memory", 2);
     } catch (const std::exception& e) {
-        error_line(std::string("internal error: ") + e.what());
-        return 3;
+        return fail(std::string("internal error: ") + e.what(), 3);
     }
     return 0;
 }
